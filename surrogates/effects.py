@@ -1,0 +1,92 @@
+"""Named, switchable physical effects: the vocabulary of the discrepancy workflow.
+
+Each effect has a strength: 1.0 is nominal, 0.0 switches it off, other values scale it (e.g. 1.5 = 50 %
+stronger drag). ``FOWTModel(effects="none")`` is the linear structural-hydro-aero model without any of them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Effect", "EFFECTS", "resolve_effects"]
+
+
+@dataclass(frozen=True)
+class Effect:
+    """A named physical effect of the surrogate.
+
+    Attributes
+    ----------
+    name : str
+    doc : str
+        One-line physical description.
+    linear : bool
+        True if the effect is linear in the state (it then appears in ``linearize()``).
+    """
+
+    name: str
+    doc: str
+    linear: bool
+
+
+EFFECTS: dict[str, Effect] = {
+    e.name: e
+    for e in (
+        Effect("quadratic_drag", "Morison viscous drag 0.5 rho Cd D |u_rel| u_rel on the spar, u_rel = wave "
+               "particle velocity minus platform velocity, integrated over depth strips.", linear=False),
+        Effect("mooring_nonlinear", "Offset-dependent catenary restoring of the three OC3 lines (hardening with "
+               "surge/sway offset, set-down), beyond the linear tangent stiffness.", linear=False),
+        Effect("aero_damping", "Thrust and rotor torque respond to the wind relative to the moving hub (dT/dV times "
+               "the hub's fore-aft velocity): aerodynamic damping of platform pitch and tower FA.", linear=True),
+        Effect("gyroscopic", "Angular momentum of the spinning rotor couples tower-top pitch and yaw rates "
+               "(moment H x omega).", linear=True),
+        Effect("rotor_3p", "Blade passing: tower shadow and wind shear modulate thrust, torque and rotor moments "
+               "at 3P and 6P.", linear=False),
+        Effect("rotor_1p", "Rotor mass and aerodynamic imbalance: a rotating in-plane force and 1P thrust and "
+               "moment variations.", linear=False),
+        Effect("p_delta", "Gravity geometric softening: the weight of tower and RNA acting through the lateral "
+               "displacements of tilt and bending (P-delta).", linear=True),
+    )
+}
+
+
+def resolve_effects(effects: str | Mapping[str, float] | None) -> dict[str, float]:
+    """Normalise an effects specification to ``{name: strength}`` over all of :data:`EFFECTS`.
+
+    Parameters
+    ----------
+    effects : {"all", "none"} or mapping or None
+        ``"all"``/None: every effect at 1.0; ``"none"``: all 0.0; a mapping sets the named strengths and leaves
+        the others at 1.0.
+
+    Returns
+    -------
+    dict
+        Strength per effect name (-).
+
+    Raises
+    ------
+    ValueError
+        Unknown effect name, or a strength that is negative or not finite.
+    """
+    if effects is None or (isinstance(effects, str) and effects == "all"):
+        return {name: 1.0 for name in EFFECTS}
+    if isinstance(effects, str):
+        if effects == "none":
+            return {name: 0.0 for name in EFFECTS}
+        raise ValueError(f"effects must be 'all', 'none' or a mapping of effect strengths, got {effects!r}")
+    out = {name: 1.0 for name in EFFECTS}
+    for name, value in dict(effects).items():
+        if name not in EFFECTS:
+            raise ValueError(f"effects: unknown effect {name!r}; known effects are {sorted(EFFECTS)}")
+        try:
+            strength = float(value)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"effects: strength of {name!r} must be a number, got {value!r}") from exc
+        if not np.isfinite(strength) or strength < 0:
+            raise ValueError(f"effects: strength of {name!r} must be finite and >= 0, got {value!r}")
+        out[name] = strength
+    return out

@@ -1,0 +1,560 @@
+"""``FOWTModel``: the OC3 Hywind surrogate as a state-space system with switchable physical effects.
+
+State ``x`` (22): generalised displacements ``q`` (10, see :data:`surrogates.structure.DOF_LABELS`), their
+rates, the rotor-speed deviation ``dOmega`` (rad/s) and the integral of it ``xi`` (rad, the pitch controller's
+integrator). Inputs ``u`` (28), in blocks:
+
+=========  =====  ===========================================================================
+block      size   meaning (SI)
+=========  =====  ===========================================================================
+const      1      1.0: carries the mean loads (gravity offsets, mean thrust, generator torque)
+wave       6      first-order wave excitation about the SWL reference point (N, N·m)
+wind       1      rotor-effective wind deviation from the mean (m/s)
+elev       1      wave elevation at the origin (m; passed to ``Wave1Elev`` only)
+hub_wind   1      hub-height point wind (m/s; passed to ``Wind1VelX`` only)
+action     2      collective blade-pitch offset (rad), generator-torque offset (N·m, low-speed shaft)
+hub        6      rotor harmonic loads at the hub, global axes (N, N·m): the 1P/3P/6P effects
+nonlinear  10     generalised forces of the nonlinear effects (drag, catenary mooring)
+=========  =====  ===========================================================================
+
+Outputs are the 45 channels of :data:`surrogates.channels.ALL_CHANNELS` in OpenFAST units. Linear effects
+(``aero_damping``, ``gyroscopic``, ``p_delta``) live in ``A``; nonlinear ones are evaluated per step by the
+simulator and enter through the ``hub`` and ``nonlinear`` input blocks.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.optimize import linear_sum_assignment
+
+from .aero import OperatingPoint, operating_point
+from .channels import ALL_CHANNELS, GAUGE_HEIGHTS, UNITS, tower_channels
+from .effects import resolve_effects
+from .load_cases import LoadCase, load_case
+from .oc3 import GRAVITY
+from .structure import DOF_LABELS, N_DOF, Structure, build_structure
+
+__all__ = ["FOWTModel", "ModalResult", "LinearSystem", "RotorHarmonics", "SensorNoise", "STATE_NAMES", "INPUT_NAMES"]
+
+STATE_NAMES: tuple[str, ...] = (
+    tuple(DOF_LABELS) + tuple(f"d_{d}" for d in DOF_LABELS) + ("rotor_speed_dev", "pitch_integrator")
+)
+N_STATE = len(STATE_NAMES)
+INPUT_BLOCKS: dict[str, slice] = {
+    "const": slice(0, 1),
+    "wave": slice(1, 7),
+    "wind": slice(7, 8),
+    "elev": slice(8, 9),
+    "hub_wind": slice(9, 10),
+    "action": slice(10, 12),
+    "hub": slice(12, 18),
+    "nonlinear": slice(18, 28),
+}
+N_INPUT = 28
+INPUT_NAMES: tuple[str, ...] = (
+    ("const", "wave_Fx", "wave_Fy", "wave_Fz", "wave_Mx", "wave_My", "wave_Mz", "wind_dev", "wave_elevation",
+     "hub_wind", "pitch_offset", "torque_offset", "hub_Fx", "hub_Fy", "hub_Fz", "hub_Mx", "hub_My", "hub_Mz")
+    + tuple(f"nl_{d}" for d in DOF_LABELS)
+)
+assert len(INPUT_NAMES) == N_INPUT and len(STATE_NAMES) == 22
+
+
+@dataclass(frozen=True)
+class RotorHarmonics:
+    """Nominal amplitudes of the rotor harmonic loads (the ``rotor_3p`` and ``rotor_1p`` effects).
+
+    These are engineering estimates for an upwind three-bladed rotor, not values from a reference report:
+    tower shadow and shear modulate thrust by a few per cent at 3P; a balancing grade of the order of ISO G16
+    and a small pitch misalignment give the 1P terms. Each effect's strength scales them.
+
+    Attributes
+    ----------
+    thrust_3p, thrust_6p : float
+        Thrust modulation at 3P and 6P as a fraction of the mean thrust (-).
+    torque_3p : float
+        Torque ripple at 3P reaching the nacelle, fraction of the mean aerodynamic torque (-).
+    moment_3p : float
+        Tilt/yaw rotor-moment amplitude at 3P as a fraction of (mean thrust × rotor radius) (-).
+    thrust_1p : float
+        1P thrust variation from aerodynamic imbalance, fraction of mean thrust (-).
+    moment_1p : float
+        1P tilt/yaw moment amplitude, fraction of (mean thrust × rotor radius) (-).
+    mass_imbalance : float
+        Static unbalance of the rotor, mass × eccentricity (kg·m).
+    """
+
+    thrust_3p: float = 0.02
+    thrust_6p: float = 0.005
+    torque_3p: float = 0.02
+    moment_3p: float = 0.005
+    thrust_1p: float = 0.005
+    moment_1p: float = 0.003
+    mass_imbalance: float = 2000.0
+
+
+@dataclass(frozen=True)
+class SensorNoise:
+    """Additive sensor noise: white plus coloured (first-order low-pass, i.e. AR(1)) per kind of channel.
+
+    Standard deviations are in each channel's output unit; ``scale`` multiplies all of them (0 = noise free).
+
+    Attributes
+    ----------
+    acceleration_white, acceleration_coloured : float
+        Tower accelerations (m/s²).
+    moment_white, moment_coloured : float
+        Tower bending moments (kN·m).
+    platform_white : float
+        Platform motions (m or deg).
+    other_white : float
+        RotSpeed (rpm), Wave1Elev (m), Wind1VelX (m/s).
+    correlation_time : float
+        Correlation time of the coloured part (s).
+    scale : float
+        Overall multiplier (-).
+    """
+
+    acceleration_white: float = 0.005
+    acceleration_coloured: float = 0.002
+    moment_white: float = 20.0
+    moment_coloured: float = 20.0
+    platform_white: float = 0.01
+    other_white: float = 0.01
+    correlation_time: float = 5.0
+    scale: float = 1.0
+
+    def std(self, channels: list[str]) -> tuple[np.ndarray, np.ndarray]:
+        """White and coloured standard deviations per channel (output units)."""
+        white = np.empty(len(channels))
+        col = np.zeros(len(channels))
+        for i, name in enumerate(channels):
+            if name.startswith("TwHt") and "AL" in name:
+                white[i], col[i] = self.acceleration_white, self.acceleration_coloured
+            elif name.startswith("TwHt"):
+                white[i], col[i] = self.moment_white, self.moment_coloured
+            elif name.startswith("Ptfm"):
+                white[i] = self.platform_white
+            else:
+                white[i] = self.other_white
+        for v in (self.acceleration_white, self.acceleration_coloured, self.moment_white, self.moment_coloured,
+                  self.platform_white, self.other_white, self.correlation_time, self.scale):
+            if not np.isfinite(v) or v < 0:
+                raise ValueError(f"noise: all SensorNoise parameters must be finite and >= 0, got {self!r}")
+        return white * self.scale, col * self.scale
+
+
+@dataclass(frozen=True)
+class ModalResult:
+    """Modal properties of the linearised model.
+
+    Attributes
+    ----------
+    labels : list of str
+        Mode names (``surge`` ... ``yaw``, ``tower_fa_1``, ``tower_ss_1``, ``tower_fa_2``, ``tower_ss_2``).
+    frequencies_hz : ndarray
+        Damped natural frequencies (Hz).
+    damping_ratios : ndarray
+        Damping ratios (-).
+    shapes : ndarray, (10, n_modes)
+        Real mode shapes in generalised coordinates, largest component +1.
+    """
+
+    labels: list[str]
+    frequencies_hz: np.ndarray
+    damping_ratios: np.ndarray
+    shapes: np.ndarray
+
+    def frequency(self, label: str) -> float:
+        """Frequency (Hz) of the mode called ``label``."""
+        if label not in self.labels:
+            raise ValueError(f"label: no mode {label!r}; modes are {self.labels}")
+        return float(self.frequencies_hz[self.labels.index(label)])
+
+    def as_table(self) -> list[dict[str, float | str]]:
+        """One dict per mode: label, frequency_hz, damping_ratio."""
+        return [{"label": lab, "frequency_hz": float(f), "damping_ratio": float(z)}
+                for lab, f, z in zip(self.labels, self.frequencies_hz, self.damping_ratios, strict=True)]
+
+    def __str__(self) -> str:
+        rows = [f"{'mode':<12}{'f (Hz)':>10}{'zeta (%)':>10}"]
+        rows += [f"{lab:<12}{f:>10.4f}{100 * z:>10.2f}"
+                 for lab, f, z in zip(self.labels, self.frequencies_hz, self.damping_ratios, strict=True)]
+        return "\n".join(rows)
+
+
+@dataclass(frozen=True)
+class LinearSystem:
+    """Continuous-time system ``x' = A x + B u``, ``y = C x + D u`` of a model at one load case (SI, outputs in
+    OpenFAST units). ``op`` is the rotor operating point (None when parked)."""
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    channels: tuple[str, ...]
+    op: OperatingPoint | None
+    rotor_speed: float  # rad/s mean
+    effects: dict[str, float]
+    structure: Structure = field(repr=False)
+
+    def equilibrium(self, nonlinear_force=None, tol: float = 1e-10) -> np.ndarray:
+        """Static equilibrium state under the mean loads (and an optional ``nonlinear_force(x) -> (10,)``)."""
+        a_qq = self.A[N_DOF:2 * N_DOF, :N_DOF]
+        b_c = self.B[N_DOF:2 * N_DOF, 0]
+        b_nl = self.B[N_DOF:2 * N_DOF, INPUT_BLOCKS["nonlinear"]]
+        x = np.zeros(N_STATE)
+        for _ in range(200):
+            f = np.zeros(N_DOF) if nonlinear_force is None else nonlinear_force(x)
+            q_new = -np.linalg.solve(a_qq, b_c + b_nl @ f)
+            done = np.max(np.abs(q_new - x[:N_DOF])) < tol * (1.0 + np.max(np.abs(q_new)))
+            x[:N_DOF] = 0.5 * (x[:N_DOF] + q_new) if nonlinear_force is not None else q_new
+            if done:
+                break
+        return x
+
+
+def _as_case(case: int | LoadCase | None) -> LoadCase | None:
+    if case is None or isinstance(case, LoadCase):
+        return case
+    if isinstance(case, (int, np.integer)) and not isinstance(case, bool):
+        return load_case(int(case))
+    raise ValueError(f"case must be an OLC number, a LoadCase or None, got {case!r}")
+
+
+class FOWTModel:
+    """Reduced model of the NREL 5 MW turbine on the OC3 Hywind spar with switchable named effects.
+
+    Parameters
+    ----------
+    effects : {"all", "none"} or mapping, optional
+        Strength of each effect in :data:`surrogates.EFFECTS` (1.0 nominal, 0.0 off). ``"all"`` (default) sets
+        every effect to 1.0, ``"none"`` gives the linear model; a mapping sets some and leaves the rest at 1.0.
+    harmonics : RotorHarmonics, optional
+        Nominal amplitudes of the rotor harmonic loads.
+    noise : SensorNoise, optional
+        Sensor noise added by :func:`surrogates.simulate`.
+    accel_gravity : bool
+        If True (default) the tower accelerations include the projection of gravity on the tilted sensor
+        axis, as an accelerometer measures it (``ALxt = a_x - g * tilt``).
+
+    Examples
+    --------
+    >>> import surrogates
+    >>> m = surrogates.FOWTModel()
+    >>> round(m.modal_analysis().frequency("heave"), 3)
+    0.032
+    >>> sorted(m.without("rotor_3p").effects.items())[3]
+    ('p_delta', 1.0)
+    """
+
+    def __init__(
+        self,
+        effects: str | Mapping[str, float] | None = "all",
+        *,
+        harmonics: RotorHarmonics | None = None,
+        noise: SensorNoise | None = None,
+        accel_gravity: bool = True,
+    ) -> None:
+        self._effects = resolve_effects(effects)
+        self.harmonics = harmonics if harmonics is not None else RotorHarmonics()
+        self.noise = noise if noise is not None else SensorNoise()
+        self.accel_gravity = bool(accel_gravity)
+        for f in self.harmonics.__dataclass_fields__:
+            v = getattr(self.harmonics, f)
+            if not np.isfinite(v) or v < 0:
+                raise ValueError(f"harmonics.{f} must be finite and >= 0, got {v!r}")
+        self.noise.std([])  # validates
+        self._systems: dict[LoadCase | None, LinearSystem] = {}
+
+    # ------------------------------------------------------------------------------------------- effects
+    @property
+    def effects(self) -> dict[str, float]:
+        """Strength of every effect (a copy)."""
+        return dict(self._effects)
+
+    def with_effects(self, **strengths: float) -> FOWTModel:
+        """New model with some effect strengths changed, e.g. ``m.with_effects(quadratic_drag=1.5)``."""
+        checked = resolve_effects(strengths)  # validates names and values
+        eff = {**self._effects, **{k: checked[k] for k in strengths}}
+        return FOWTModel(eff, harmonics=self.harmonics, noise=self.noise, accel_gravity=self.accel_gravity)
+
+    def without(self, *names: str) -> FOWTModel:
+        """New model with the named effects switched off."""
+        return self.with_effects(**{n: 0.0 for n in names})
+
+    def with_noise(self, noise: SensorNoise | None = None, **changes: float) -> FOWTModel:
+        """New model with another sensor-noise specification (``scale=0`` for noise-free records)."""
+        new_noise = replace(noise if noise is not None else self.noise, **changes)
+        return FOWTModel(self._effects, harmonics=self.harmonics, noise=new_noise, accel_gravity=self.accel_gravity)
+
+    def __repr__(self) -> str:
+        on = [f"{k}={v:g}" for k, v in self._effects.items() if v != 0.0]
+        return f"FOWTModel(effects={{{', '.join(on)}}})" if on else "FOWTModel(effects='none')"
+
+    def to_dict(self) -> dict:
+        """JSON-friendly description (effects, harmonics, noise, accel_gravity)."""
+        return {
+            "effects": self.effects,
+            "harmonics": {f: getattr(self.harmonics, f) for f in self.harmonics.__dataclass_fields__},
+            "noise": {f: getattr(self.noise, f) for f in self.noise.__dataclass_fields__},
+            "accel_gravity": self.accel_gravity,
+        }
+
+    @classmethod
+    def from_dict(cls, d: Mapping) -> FOWTModel:
+        """Inverse of :meth:`to_dict`."""
+        return cls(d.get("effects", "all"), harmonics=RotorHarmonics(**d.get("harmonics", {})),
+                   noise=SensorNoise(**d.get("noise", {})), accel_gravity=d.get("accel_gravity", True))
+
+    @cached_property
+    def structure(self) -> Structure:
+        """The linearised structure (shared, cached)."""
+        return build_structure()
+
+    # -------------------------------------------------------------------------------------- state space
+    def system(self, case: int | LoadCase | None = None) -> LinearSystem:
+        """Continuous-time state-space system at a load case (cached per case).
+
+        Parameters
+        ----------
+        case : int or LoadCase or None
+            Load case; None means parked (no wind, rotor locked, still water).
+        """
+        lc = _as_case(case)
+        if lc not in self._systems:
+            self._systems[lc] = self._assemble(lc)
+        return self._systems[lc]
+
+    def _assemble(self, lc: LoadCase | None) -> LinearSystem:  # noqa: C901 - one linear-algebra recipe
+        st = self.structure
+        eff = self._effects
+        s_aero, s_gyro, s_pd = eff["aero_damping"], eff["gyroscopic"], eff["p_delta"]
+        operating = lc is not None and lc.wind_speed > 0 and lc.rotor_rpm > 0
+        op = operating_point(lc.wind_speed, lc.rotor_rpm, st.rotor_inertia_lss) if operating else None
+        omega0 = op.rotor_speed if op is not None else 0.0
+
+        m = st.mass
+        k = st.stiffness + s_pd * st.stiffness_pdelta
+        c = st.damping.copy()
+        e_s = st.shaft_axis
+        h_v = e_s @ st.hub_translation  # hub velocity along the shaft per qdot == generalised thrust direction
+        r_s = e_s @ st.tower_top_rotation  # generalised force of a moment about the shaft at the tower top
+        j_hub, r_tt = st.hub_translation, st.tower_top_rotation
+
+        # thrust deviation dT and generator torque Qg as rows over [x; u]
+        n_x, n_u = N_STATE, N_INPUT
+        t_x, t_u = np.zeros(n_x), np.zeros(n_u)
+        qa_x, qa_u = np.zeros(n_x), np.zeros(n_u)  # aerodynamic torque deviation
+        qg_x, qg_u = np.zeros(n_x), np.zeros(n_u)  # generator torque deviation
+        t0 = qg0 = 0.0
+        iw, ia = INPUT_BLOCKS["wind"].start, INPUT_BLOCKS["action"].start
+        if op is not None:
+            t0, qg0 = op.thrust, op.generator_torque_lss
+            pitch_x = np.zeros(n_x)
+            pitch_x[2 * N_DOF] = op.kp
+            pitch_x[2 * N_DOF + 1] = op.ki
+            for row_x, row_u, dv, dw, db in ((t_x, t_u, op.dT_dV, op.dT_dOmega, op.dT_dpitch),
+                                             (qa_x, qa_u, op.dQ_dV, op.dQ_dOmega, op.dQ_dpitch)):
+                row_u[iw] += dv
+                row_x[N_DOF:2 * N_DOF] += -s_aero * dv * h_v
+                row_x[2 * N_DOF] += dw
+                row_x += db * pitch_x
+                row_u[ia] += db
+            qg_x[2 * N_DOF] = op.dQgen_dOmega
+            qg_u[ia + 1] = 1.0
+
+        # generalised forces f = F_x x + F_u u (besides -K q - C qdot)
+        f_x = np.zeros((N_DOF, n_x))
+        f_u = np.zeros((N_DOF, n_u))
+        f_x += np.outer(h_v, t_x) + np.outer(r_s, qg_x)
+        f_u += np.outer(h_v, t_u) + np.outer(r_s, qg_u)
+        f_u[:, 0] += st.gravity_load + h_v * t0 + r_s * qg0
+        f_u[:6, INPUT_BLOCKS["wave"]] += np.eye(6)
+        hub = INPUT_BLOCKS["hub"]
+        f_u[:, hub.start:hub.start + 3] += j_hub.T
+        f_u[:, hub.start + 3:hub.stop] += r_tt.T
+        f_u[:, INPUT_BLOCKS["nonlinear"]] += np.eye(N_DOF)
+        if op is not None and s_gyro:
+            h0 = st.spin_inertia * omega0
+            gyro = s_gyro * h0 * r_tt.T @ _skew(e_s) @ r_tt
+            f_x[:, N_DOF:2 * N_DOF] += gyro
+
+        minv = np.linalg.inv(m)
+        a = np.zeros((n_x, n_x))
+        b = np.zeros((n_x, n_u))
+        a[:N_DOF, N_DOF:2 * N_DOF] = np.eye(N_DOF)
+        a[N_DOF:2 * N_DOF, :N_DOF] = -minv @ k
+        a[N_DOF:2 * N_DOF, N_DOF:2 * N_DOF] = -minv @ c
+        a[N_DOF:2 * N_DOF] += minv @ f_x
+        b[N_DOF:2 * N_DOF] = minv @ f_u
+        if op is not None:
+            j = st.rotor_inertia_lss
+            a[2 * N_DOF] = (qa_x - qg_x) / j
+            b[2 * N_DOF] = (qa_u - qg_u) / j
+            a[2 * N_DOF + 1, 2 * N_DOF] = 1.0
+
+        # ------------------------------------------------------------------ outputs (45 channels)
+        qdd_x, qdd_u = a[N_DOF:2 * N_DOF], b[N_DOF:2 * N_DOF]
+        thrust_x, thrust_u = t_x, t_u.copy()
+        thrust_u[0] += t0
+        rows_x: dict[str, np.ndarray] = {}
+        rows_u: dict[str, np.ndarray] = {}
+        g_acc = GRAVITY if self.accel_gravity else 0.0
+        p_hub = st.hub_position
+        ez = np.array([0.0, 0.0, 1.0])
+        for gi, h in enumerate(GAUGE_HEIGHTS, start=1):
+            t_h = st.point_translation(h)
+            r_h = st.point_rotation(h)
+            ax_x = t_h[0] @ qdd_x
+            ax_x[:N_DOF] -= g_acc * r_h[1]
+            ay_x = t_h[1] @ qdd_x
+            ay_x[:N_DOF] += g_acc * r_h[0]
+            rows_x[f"TwHt{gi}ALxt"], rows_u[f"TwHt{gi}ALxt"] = ax_x, t_h[0] @ qdd_u
+            rows_x[f"TwHt{gi}ALyt"], rows_u[f"TwHt{gi}ALyt"] = ay_x, t_h[1] @ qdd_u
+            # bending moment vector (N m) about the gauge from everything above it
+            mom_x = np.zeros((3, n_x))
+            mom_u = np.zeros((3, n_u))
+            p_h = np.array([0.0, 0.0, h])
+            for body in st.bodies:
+                if body.position[2] <= h:
+                    continue
+                lever = _skew(body.position - p_h)
+                inertial = -(body.mass * lever @ body.translation + body.inertia @ body.rotation)  # (3, N_DOF)
+                mom_x += inertial @ qdd_x
+                mom_u += inertial @ qdd_u
+                mom_u[:, 0] += lever @ (-body.mass * GRAVITY * ez)
+                mom_x[:, :N_DOF] += s_pd * body.mass * GRAVITY * _skew(ez) @ (body.translation - t_h)
+            lever_hub = _skew(p_hub - p_h)
+            mom_x += np.outer(lever_hub @ e_s, thrust_x)
+            mom_u += np.outer(lever_hub @ e_s, thrust_u)
+            mom_x[:, :N_DOF] += -_skew(e_s * t0) @ (st.hub_translation - t_h)
+            mom_u[:, hub.start:hub.start + 3] += lever_hub
+            mom_u[:, hub.start + 3:hub.stop] += np.eye(3)
+            mom_x += np.outer(e_s, qg_x)
+            mom_u += np.outer(e_s, qg_u)
+            mom_u[:, 0] += e_s * qg0
+            rows_x[f"TwHt{gi}MLyt"], rows_u[f"TwHt{gi}MLyt"] = mom_x[1] / 1e3, mom_u[1] / 1e3
+            rows_x[f"TwHt{gi}MLxt"], rows_u[f"TwHt{gi}MLxt"] = mom_x[0] / 1e3, mom_u[0] / 1e3
+        for i, name in enumerate(("PtfmSurge", "PtfmSway", "PtfmHeave", "PtfmRoll", "PtfmPitch", "PtfmYaw")):
+            rx = np.zeros(n_x)
+            rx[i] = 1.0 if i < 3 else np.rad2deg(1.0)
+            rows_x[name], rows_u[name] = rx, np.zeros(n_u)
+        rx = np.zeros(n_x)
+        rx[2 * N_DOF] = 30.0 / np.pi
+        ru = np.zeros(n_u)
+        ru[0] = omega0 * 30.0 / np.pi
+        rows_x["RotSpeed"], rows_u["RotSpeed"] = rx, ru
+        for name, idx in (("Wave1Elev", INPUT_BLOCKS["elev"].start), ("Wind1VelX", INPUT_BLOCKS["hub_wind"].start)):
+            ru = np.zeros(n_u)
+            ru[idx] = 1.0
+            rows_x[name], rows_u[name] = np.zeros(n_x), ru
+        cmat = np.array([rows_x[ch] for ch in ALL_CHANNELS])
+        dmat = np.array([rows_u[ch] for ch in ALL_CHANNELS])
+        return LinearSystem(a, b, cmat, dmat, tuple(ALL_CHANNELS), op, omega0, dict(eff), st)
+
+    # ----------------------------------------------------------------------------------------- analysis
+    def modal_analysis(self, case: int | LoadCase | None = None) -> ModalResult:
+        """Natural frequencies, damping ratios and mode shapes of the linearised model.
+
+        Parameters
+        ----------
+        case : int or LoadCase or None
+            None (default): parked rotor, no wind, still water -- the conditions of the OC3 free-decay
+            frequencies (Jonkman 2010). With a load case: about its operating point, with aerodynamic
+            damping, gyroscopics and the pitch controller as the effects say.
+
+        Returns
+        -------
+        ModalResult
+            The 10 structural modes, labelled ``surge`` ... ``yaw``, ``tower_fa_1``, ``tower_ss_1``,
+            ``tower_fa_2``, ``tower_ss_2``, sorted by frequency.
+        """
+        sys = self.system(case)
+        st = self.structure
+        k = st.stiffness + self._effects["p_delta"] * st.stiffness_pdelta
+        w2, phi = sla.eigh(k, st.mass)
+        # label the undamped modes by where their potential energy sits (one label per mode)
+        energy = np.abs(phi * (k @ phi))
+        energy /= energy.sum(axis=0, keepdims=True)
+        _, label_of = linear_sum_assignment(-energy.T)
+        base_labels = [DOF_LABELS[j] for j in label_of]
+        # damped eigenvalues of the full system, matched to the undamped modes by MAC on q
+        lam, vec = np.linalg.eig(sys.A[:2 * N_DOF, :2 * N_DOF])
+        keep = np.where(lam.imag > 1e-9)[0]
+        lam, vec = lam[keep], vec[:N_DOF, keep]
+        mac = np.abs(phi.T @ st.mass @ vec) ** 2 / (
+            np.einsum("ij,ij->j", phi, st.mass @ phi)[:, None]
+            * np.real(np.einsum("ij,ij->j", vec.conj(), st.mass @ vec))[None, :]
+        )
+        rows, cols = linear_sum_assignment(-mac)
+        freqs = np.empty(N_DOF)
+        zetas = np.empty(N_DOF)
+        shapes = np.empty((N_DOF, N_DOF))
+        for r, cidx in zip(rows, cols, strict=True):
+            ev = lam[cidx]
+            freqs[r] = abs(ev.imag) / (2 * np.pi)
+            zetas[r] = -ev.real / abs(ev)
+            v = vec[:, cidx]
+            v = np.real(v * np.exp(-1j * np.angle(v[np.argmax(np.abs(v))])))
+            shapes[:, r] = v / np.max(np.abs(v))
+        order = np.argsort(freqs)
+        labels = _tower_labels([base_labels[i] for i in order], freqs[order])
+        return ModalResult(labels, freqs[order], zetas[order], shapes[:, order])
+
+    def linearize(self, case: int | LoadCase | None = None, plane: str | None = None):
+        """Linear state-space model about the operating point as a ``control.StateSpace``.
+
+        Parameters
+        ----------
+        case : int or LoadCase or None
+            Load case (None: parked, still water).
+        plane : {"FA", "SS"} or None
+            "FA"/"SS": the paper's 18 channels of that plane (accelerations at gauges 1-9, then bending
+            moments at gauges 1-9); None: all 45 channels.
+
+        Returns
+        -------
+        control.StateSpace
+            Continuous-time; named states (:data:`STATE_NAMES`), inputs (wave excitation ``wave_Fx`` ...
+            ``wave_Mz``, rotor-effective wind deviation ``wind_dev``, ``pitch_offset``, ``torque_offset``) and
+            outputs (channel names). Outputs are deviations from the operating-point mean. The nonlinear
+            effects do not appear (their linearisation about zero velocity and offset is zero or already in
+            the linear terms).
+        """
+        import control
+
+        sys = self.system(case)
+        names = list(ALL_CHANNELS) if plane is None else tower_channels(plane)
+        idx = [ALL_CHANNELS.index(n) for n in names]
+        cols = list(range(INPUT_BLOCKS["wave"].start, INPUT_BLOCKS["wave"].stop)) + [
+            INPUT_BLOCKS["wind"].start, INPUT_BLOCKS["action"].start, INPUT_BLOCKS["action"].start + 1]
+        return control.ss(
+            sys.A, sys.B[:, cols], sys.C[idx], sys.D[np.ix_(idx, cols)],
+            states=list(STATE_NAMES), inputs=[INPUT_NAMES[c] for c in cols], outputs=names,
+            name="fowt_linear",
+        )
+
+    @staticmethod
+    def units(channels: list[str]) -> list[str]:
+        """OpenFAST units of channels."""
+        return [UNITS[c] for c in channels]
+
+
+def _tower_labels(labels: list[str], freqs: np.ndarray) -> list[str]:
+    """Order-consistent tower labels: the lower FA/SS mode of each pair is _1, the higher _2."""
+    out = list(labels)
+    for plane in ("fa", "ss"):
+        idx = [i for i, lab in enumerate(out) if lab.startswith(f"tower_{plane}")]
+        for n, i in enumerate(sorted(idx, key=lambda i: freqs[i]), start=1):
+            out[i] = f"tower_{plane}_{n}"
+    return out
+
+
+def _skew(p: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -p[2], p[1]], [p[2], 0.0, -p[0]], [-p[1], p[0], 0.0]])
+
