@@ -10,11 +10,12 @@ linearised about it:
     dQ = Q_V (V - v_hub) + Q_Omega dOmega + Q_beta dbeta
 
 with ``v_hub`` the fore-aft velocity of the hub (the ``aero_damping`` effect). The baseline controller is
-the one Jonkman (2010) used for OC3 Hywind: constant generator torque above rated and a gain-scheduled PI
-collective-pitch loop on rotor speed whose natural frequency was lowered to 0.2 rad/s (below the platform
-pitch frequency) so that the platform pitch mode is not destabilised. Here the PI gains are computed from the
-table's sensitivities at the operating point for that frequency and a damping ratio of 0.7. Below rated the
-generator torque follows the optimal-tip-speed law and the pitch stays at fine pitch.
+the one Jonkman (2010) used for OC3 Hywind: constant generator torque above rated and the NREL 5 MW
+gain-scheduled PI collective-pitch loop on rotor speed, with its natural frequency lowered to 0.2 rad/s (near
+the platform pitch frequency) so that the platform pitch mode is not destabilised. The gains follow the
+published design rule (Jonkman et al. 2009, section 7.4: dP/dbeta = -25.52 MW/rad at rated, gain-correction
+factor 1 / (1 + beta / 6.302336 deg)). Below rated the generator torque follows the optimal-tip-speed law and
+the pitch stays at fine pitch.
 """
 
 from __future__ import annotations
@@ -37,8 +38,12 @@ RATED = {
     "rotor_speed_rpm": 12.1,  # rpm
     "wind_speed": 11.4,  # m/s
     "min_pitch_rad": 0.0,
-    "pitch_controller_frequency": 0.2,  # rad/s, OC3 Hywind detuned (Jonkman 2010, section 7)
+    "pitch_controller_frequency": 0.2,  # rad/s, OC3 Hywind detuned (Jonkman 2010, section 7.2)
     "pitch_controller_damping": 0.7,  # -
+    # gain scheduling of the NREL 5 MW baseline controller (Jonkman et al. 2009, section 7.4): sensitivity of
+    # aerodynamic power to pitch at rated, and the pitch angle at which it has doubled
+    "dP_dpitch_rated": -25.52e6,  # W/rad
+    "pitch_doubling_rad": float(np.deg2rad(6.302336)),
 }
 
 
@@ -232,11 +237,14 @@ def operating_point(wind_speed: float, rotor_rpm: float | None = None, drivetrai
         "dQ_dV": d(1, dv, 0, 0), "dQ_dOmega": d(1, 0, dw, 0), "dQ_dpitch": d(1, 0, 0, db),
     }
     if above:
-        # constant generator torque; PI pitch loop placed at (omega_n, zeta) on J dOmega = dQ/dbeta dbeta + ...
+        # constant generator torque (OC3 Hywind); gain-scheduled PI pitch loop of the NREL 5 MW baseline
+        # controller: gains placed for (omega_n, zeta) with the *published* dP/dbeta at rated, scheduled by
+        # GK = 1 / (1 + beta / beta_K) (Jonkman et al. 2009, eqs. 7-? "gain-correction factor").
         wn, zeta = RATED["pitch_controller_frequency"], RATED["pitch_controller_damping"]
-        dq_db = sens["dQ_dpitch"]  # negative
-        kp = (2.0 * zeta * wn * drivetrain_inertia + sens["dQ_dOmega"]) / (-dq_db)
-        ki = wn**2 * drivetrain_inertia / (-dq_db)
+        dp_db0 = RATED["dP_dpitch_rated"]
+        gk = 1.0 / (1.0 + pitch / RATED["pitch_doubling_rad"])
+        kp = 2.0 * drivetrain_inertia * omega_rated * zeta * wn / (-dp_db0) * gk
+        ki = drivetrain_inertia * omega_rated * wn**2 / (-dp_db0) * gk
         dqgen = 0.0
     else:
         kp = ki = 0.0

@@ -1,0 +1,140 @@
+"""Modal properties of the surrogate against independent references.
+
+References
+----------
+* Jonkman, J. (2010). Definition of the Floating System for Phase IV of OC3. NREL/TP-500-47535: full-system
+  natural frequencies from FAST free-decay tests (surge/sway 0.0080, heave 0.0324, roll 0.0342, pitch 0.0343,
+  yaw 0.1210 Hz) and 1st tower FA/SS (0.4816 Hz FA in Table 9-1 for the FA mode).
+* pybmodes' finite-element solve of the OC3 Hywind BModes deck (computed in the test, not copied): the coupled
+  tower bending frequencies of the same structure with a rigid RNA.
+"""
+
+import numpy as np
+import pytest
+
+import surrogates
+from surrogates.oc3 import load_oc3
+from surrogates.structure import build_structure
+
+JONKMAN_2010 = {"surge": 0.0080, "sway": 0.0080, "heave": 0.0324, "roll": 0.0342, "pitch": 0.0343, "yaw": 0.1210}
+
+
+@pytest.fixture(scope="module")
+def modes() -> surrogates.ModalResult:
+    return surrogates.FOWTModel().modal_analysis()
+
+
+@pytest.mark.parametrize("label", sorted(JONKMAN_2010))
+def test_platform_frequencies_match_jonkman_2010(modes, label):
+    # tolerance 10 % (issue: 10-15 %): FAST free-decay values, our linear Rayleigh-Ritz model
+    assert modes.frequency(label) == pytest.approx(JONKMAN_2010[label], rel=0.10)
+
+
+def test_first_tower_modes_within_6_percent(modes):
+    # 1st tower FA/SS of the full OC3 system: 0.48 / 0.49 Hz (issue, from BModes/FAST)
+    assert modes.frequency("tower_fa_1") == pytest.approx(0.48, rel=0.06)
+    assert modes.frequency("tower_ss_1") == pytest.approx(0.49, rel=0.06)
+
+
+def test_second_side_to_side_mode_within_10_percent(modes):
+    # 2nd SS: 2.003 Hz (OpenFAST linearisation, seed paper Table 3) / 2.053 Hz (BModes deck)
+    assert modes.frequency("tower_ss_2") == pytest.approx(2.03, rel=0.10)
+
+
+@pytest.fixture(scope="module")
+def pybmodes_frequencies() -> np.ndarray:
+    from importlib import resources
+
+    from pybmodes.models import Tower
+
+    bmi = (resources.files("pybmodes") / "_examples" / "sample_inputs" / "reference_turbines"
+           / "07_nrel5mw_oc3hywind_spar" / "07_nrel5mw_oc3hywind_spar_tower.bmi")
+    return np.asarray(Tower(str(bmi)).run(n_modes=12).frequencies)
+
+
+def test_tower_bending_modes_match_pybmodes_fe(modes, pybmodes_frequencies):
+    """Every tower bending frequency of ours has an independent FE counterpart within 6 %.
+
+    pybmodes also finds a torsion-dominated mode at ~1.57 Hz which our bending-only model has no DOF for.
+    """
+    ours = [modes.frequency(k) for k in ("tower_fa_1", "tower_ss_1", "tower_fa_2", "tower_ss_2")]
+    elastic = pybmodes_frequencies[pybmodes_frequencies > 0.3]
+    for f in ours:
+        assert np.min(np.abs(elastic - f) / elastic) < 0.06, (f, elastic)
+
+
+def test_p_delta_softens_tower_and_platform_tilt():
+    stiff = surrogates.FOWTModel(effects={"p_delta": 0.0}).modal_analysis()
+    soft = surrogates.FOWTModel().modal_analysis()
+    for label in ("pitch", "roll", "tower_fa_1", "tower_ss_1"):
+        assert soft.frequency(label) < stiff.frequency(label)
+    # closed form for the tilt modes: the weight above SWL lowers the restoring by g * sum(m z)
+    st = build_structure()
+    above = sum(b.mass * b.position[2] for b in st.bodies if b.name != "platform")
+    assert -st.stiffness_pdelta[4, 4] == pytest.approx(9.80665 * above, rel=0.02)
+
+
+def test_mass_matrix_is_symmetric_positive_definite_and_total_mass_right():
+    st = build_structure()
+    assert np.allclose(st.mass, st.mass.T)
+    assert np.all(np.linalg.eigvalsh(st.mass) > 0)
+    d = load_oc3()
+    # heave DOF sees all structural mass plus the heave added mass
+    structural = d.platform_mass + sum(b.mass for b in st.bodies if b.name != "platform")
+    assert st.mass[2, 2] == pytest.approx(structural + d.added_mass[2, 2], rel=1e-9)
+    # tower mass from the deck's distributed density (249,718 kg, Jonkman 2010 Table 2-? / DESIGN.md)
+    assert sum(b.mass for b in st.bodies if b.name == "tower") == pytest.approx(249_718, rel=0.002)
+    # RNA ~350,000 kg (Jonkman et al. 2009)
+    assert sum(b.mass for b in st.bodies if b.name in ("nacelle", "hub", "blades")) == pytest.approx(350_000, rel=0.01)
+
+
+def test_mooring_solver_reproduces_linear_surge_stiffness():
+    """MoorPy's catenary around zero offset gives the K11 = 41,180 N/m that Jonkman (2010) lists."""
+    from surrogates.mooring import mooring_table
+
+    assert mooring_table().linear_stiffness == pytest.approx(41_180, rel=0.01)
+    assert load_oc3().mooring_stiffness[0, 0] == pytest.approx(41_180, rel=1e-6)
+
+
+def test_mooring_hardens_with_offset():
+    from surrogates.mooring import mooring_table
+
+    tab = mooring_table()
+    tangent = np.gradient(tab.horizontal_force, tab.offset)
+    assert np.all(np.diff(tangent[5:]) > -1e-6 * tangent.max())
+    assert tangent[20] > 1.5 * tangent[0]
+
+
+def test_operating_point_at_12_mps_is_the_nrel_5mw():
+    """NREL 5 MW above rated (Jonkman et al. 2009): 12.1 rpm, pitch ~3.8 deg at 12 m/s, 5.3 MW aero power,
+    thrust of the order of 600-700 kN."""
+    from surrogates.aero import operating_point
+
+    j = build_structure().rotor_inertia_lss
+    op = operating_point(12.0, 12.1, j)
+    assert op.above_rated
+    assert op.power == pytest.approx(5.0e6 / 0.944, rel=1e-3)
+    assert np.rad2deg(op.pitch) == pytest.approx(3.83, abs=0.6)
+    assert 550e3 < op.thrust < 750e3
+    assert op.dT_dV > 0 and op.dQ_dpitch < 0
+    # OC3 Hywind baseline pitch controller (Jonkman 2010, section 7.2): gains at fine pitch, referred to the
+    # high-speed shaft, KP = 0.006275604 s and KI = 0.0008965149; ours are scheduled by GK = 1/(1+beta/beta_K)
+    gk = 1.0 / (1.0 + op.pitch / np.deg2rad(6.302336))
+    assert op.kp / gk / 97.0 == pytest.approx(0.006275604, rel=0.01)
+    assert op.ki / gk / 97.0 == pytest.approx(0.0008965149, rel=0.01)
+
+
+def test_linearize_plane_fa_has_the_papers_18_channels():
+    ss = surrogates.FOWTModel().linearize(surrogates.load_case(7), plane="FA")
+    assert ss.noutputs == 18
+    assert ss.output_labels[:9] == [f"TwHt{i}ALxt" for i in range(1, 10)]
+    assert ss.output_labels[9:] == [f"TwHt{i}MLyt" for i in range(1, 10)]
+    assert ss.nstates == 22
+    # Structural poles of the operating turbine (platform pitch and above) are stable with the detuned
+    # controller and aerodynamic damping. A slow (~0.008 Hz) surge/controller pole may be marginal near rated
+    # wind -- the well-known negative-damping interaction of pitch control and platform motion -- which the
+    # quadratic drag of the simulation damps; it must stay slow (doubling time > 5 min).
+    poles = ss.poles()
+    fast = np.abs(poles) > 2 * np.pi * 0.02
+    assert np.all(np.real(poles[fast]) < 0)
+    assert np.max(np.real(poles)) < np.log(2) / 300.0

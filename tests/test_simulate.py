@@ -1,0 +1,210 @@
+"""Time-domain behaviour of the surrogate: OC3-like response, effects in the direction physics says, an
+independent check of the integrator against scipy's lsim of ``linearize()``, determinism and bad input."""
+
+import numpy as np
+import pytest
+from scipy.signal import welch
+
+import surrogates
+from surrogates.load_cases import load_case
+from surrogates.model import INPUT_BLOCKS
+from surrogates.simulate import Simulator
+
+
+def band_power(x, fs, f_lo, f_hi, nperseg=8192):
+    f, p = welch(x - x.mean(), fs=fs, nperseg=min(nperseg, len(x)))
+    sel = (f >= f_lo) & (f <= f_hi)
+    return float(np.trapezoid(p[sel], f[sel]))
+
+
+def psd_peak_ratio(x, fs, f0, half_width=0.01, nperseg=16384):
+    """PSD at f0 relative to the median PSD of the +-0.05 Hz neighbourhood (a line detector)."""
+    f, p = welch(x - x.mean(), fs=fs, nperseg=min(nperseg, len(x)))
+    line = p[(f > f0 - half_width) & (f < f0 + half_width)].max()
+    ring = p[((f > f0 - 0.06) & (f < f0 - 0.02)) | ((f > f0 + 0.02) & (f < f0 + 0.06))]
+    return line / np.median(ring)
+
+
+@pytest.fixture(scope="module")
+def olc7_20min():
+    return surrogates.simulate(surrogates.FOWTModel(), 7, duration=1200.0, dt=0.0125, seed=11)
+
+
+def test_rated_wind_run_is_oc3_like(olc7_20min):
+    rec = olc7_20min
+    # Jonkman 2010 / OC3 phase IV: mean surge offset of the order of 15-20 m and pitch of a few degrees at rated
+    assert 10.0 < rec["PtfmSurge"].mean() < 35.0
+    assert 2.0 < rec["PtfmPitch"].mean() < 8.0
+    base_moment = rec["TwHt1MLyt"].mean() / 1e3  # kN m -> MN m
+    assert 40.0 < base_moment < 120.0
+    assert rec["RotSpeed"].mean() == pytest.approx(12.1, abs=0.2)
+
+
+def test_3p_line_in_side_to_side_tower_top_acceleration(olc7_20min):
+    rec = olc7_20min
+    f3p = 3 * 12.1 / 60.0  # 0.605 Hz
+    assert psd_peak_ratio(rec["TwHt9ALyt"], rec.fs, f3p) > 10.0
+
+
+def test_response_peaks_at_platform_pitch_and_tower_modes(olc7_20min):
+    rec = olc7_20min
+    modes = surrogates.FOWTModel().modal_analysis(7)
+    f, p = welch(rec["TwHt9ALxt"] - rec["TwHt9ALxt"].mean(), fs=rec.fs, nperseg=2**16)
+    f_tower = modes.frequency("tower_fa_1")
+    band = (f > 0.3) & (f < 1.2)
+    f_peak = f[band][np.argmax(p[band])]
+    assert f_peak == pytest.approx(f_tower, abs=0.03)
+    fp, pp = welch(rec["PtfmPitch"] - rec["PtfmPitch"].mean(), fs=rec.fs, nperseg=2**16)
+    low = (fp > 0.015) & (fp < 0.06)
+    assert fp[low][np.argmax(pp[low])] == pytest.approx(modes.frequency("pitch"), abs=0.008)
+
+
+# ------------------------------------------------------------------------------------- each effect alone
+def _pair(effect, case, duration=900.0, seed=5):
+    base = surrogates.FOWTModel(effects="none").with_noise(scale=0.0)
+    with_eff = base.with_effects(**{effect: 1.0})
+    kw = dict(duration=duration, dt=0.025, seed=seed, noise=False)
+    return surrogates.simulate(base, case, **kw), surrogates.simulate(with_eff, case, **kw)
+
+
+def test_quadratic_drag_damps_platform_motion():
+    off, on = _pair("quadratic_drag", 10)
+    assert np.std(on["PtfmPitch"]) < np.std(off["PtfmPitch"])
+    assert np.std(on["PtfmSurge"]) < np.std(off["PtfmSurge"])
+
+
+def test_catenary_mooring_hardens_surge():
+    off, on = _pair("mooring_nonlinear", 7)
+    # hardening: smaller mean offset under the same mean thrust
+    assert on["PtfmSurge"].mean() < off["PtfmSurge"].mean() - 1.0
+
+
+def test_aero_damping_reduces_tower_fore_aft_resonance_and_pitch_motion():
+    off, on = _pair("aero_damping", 7)
+    f1 = surrogates.FOWTModel(effects="none").modal_analysis(7).frequency("tower_fa_1")
+    fs = off.fs
+    assert band_power(on["TwHt9ALxt"], fs, f1 - 0.05, f1 + 0.05) < 0.8 * band_power(off["TwHt9ALxt"], fs, f1 - 0.05,
+                                                                                   f1 + 0.05)
+    assert np.std(on["PtfmPitch"]) < np.std(off["PtfmPitch"])
+
+
+def test_gyroscopic_coupling_moves_yaw():
+    off, on = _pair("gyroscopic", 7)  # waves along the wind: yaw is excited only through the coupling
+    assert np.std(on["PtfmYaw"]) > 2.0 * np.std(off["PtfmYaw"]) + 1e-6
+
+
+def test_rotor_3p_puts_a_line_at_3p():
+    off, on = _pair("rotor_3p", 7)
+    f3p = 3 * 12.1 / 60.0
+    assert psd_peak_ratio(on["TwHt9ALyt"], on.fs, f3p) > 10 * psd_peak_ratio(off["TwHt9ALyt"], off.fs, f3p)
+
+
+def test_rotor_1p_puts_a_line_at_1p():
+    off, on = _pair("rotor_1p", 7)
+    f1p = 12.1 / 60.0
+    assert psd_peak_ratio(on["TwHt9ALyt"], on.fs, f1p) > 3 * psd_peak_ratio(off["TwHt9ALyt"], off.fs, f1p)
+
+
+def test_p_delta_increases_tilt_and_base_moment():
+    off, on = _pair("p_delta", 7)
+    assert on["PtfmPitch"].mean() > off["PtfmPitch"].mean()
+    assert on["TwHt1MLyt"].mean() > off["TwHt1MLyt"].mean()
+
+
+# --------------------------------------------------------------------------- integrator vs linearize()
+def test_linear_simulation_matches_lsim_of_linearize():
+    """The compiled integrator and scipy's lsim of ``linearize()`` agree on the same forcing."""
+    from scipy.signal import lsim
+
+    model = surrogates.FOWTModel(effects="none").with_noise(scale=0.0)
+    case = load_case(4)
+    dt, seed, duration = 0.0125, 3, 200.0
+    rec = surrogates.simulate(model, case, duration=duration, dt=dt, seed=seed, transient=0.0, noise=False)
+    sim = Simulator(model, case, dt)
+    n = rec.n_samples
+    u_ex, _, _ = sim.forcing(n * sim.substeps, np.random.SeedSequence(seed).spawn(2)[0])
+    ss = model.linearize(case)
+    cols = [ss.input_labels.index(k) for k in ss.input_labels]
+    u = np.zeros((n, ss.ninputs))
+    u[:, 0:6] = u_ex[:n, INPUT_BLOCKS["wave"]]
+    u[:, 6] = u_ex[:n, INPUT_BLOCKS["wind"].start]
+    assert cols == list(range(ss.ninputs))
+    t = np.arange(n) * dt
+    _, y_dev, _ = lsim((ss.A, ss.B, ss.C, ss.D), u, t, interp=True)
+    y_eq = sim.system.C @ sim.x_eq + sim.system.D[:, 0]
+    # Wave1Elev and Wind1VelX are pass-through channels, not outputs of the linear dynamics
+    keep = [i for i, c in enumerate(rec.channels) if c not in ("Wave1Elev", "Wind1VelX")]
+    ours = rec.y[:, keep] - y_eq[keep]
+    ref = y_dev[:, keep]
+    scale = np.std(ref, axis=0) + 1e-12
+    err = np.max(np.abs(ours - ref), axis=0) / scale
+    assert np.max(err) < 1e-3, dict(zip(np.array(rec.channels)[keep], err))
+
+
+@pytest.mark.slow
+def test_linear_model_is_stable_for_six_hours():
+    model = surrogates.FOWTModel(effects="none")
+    rec = surrogates.simulate(model, 10, duration=6 * 3600.0, dt=0.05, seed=1)
+    assert np.all(np.isfinite(rec.y))
+    first, last = rec.slice_time(0, 3600), rec.slice_time(5 * 3600, 6 * 3600)
+    for ch in ("PtfmPitch", "TwHt1MLyt", "TwHt9ALxt"):
+        assert np.std(last[ch]) < 2.0 * np.std(first[ch])
+
+
+def test_full_model_long_run_stays_bounded():
+    rec = surrogates.simulate(surrogates.FOWTModel(), 10, duration=3600.0, dt=0.05, seed=2)
+    assert np.all(np.isfinite(rec.y))
+    assert np.max(np.abs(rec["PtfmPitch"])) < 20.0
+
+
+# --------------------------------------------------------------------------------- determinism and I/O
+def test_same_seed_same_bytes_and_different_seeds_differ(tmp_path):
+    m = surrogates.FOWTModel()
+    a = surrogates.simulate(m, 4, duration=60.0, seed=7)
+    b = surrogates.simulate(m, 4, duration=60.0, seed=7)
+    c = surrogates.simulate(m, 4, duration=60.0, seed=8)
+    assert a.y.tobytes() == b.y.tobytes()
+    assert not np.allclose(a.y, c.y)
+    path = a.save(tmp_path / "rec.npz")
+    back = surrogates.Record.load(path)
+    assert back.y.tobytes() == a.y.tobytes() and back.channels == a.channels and back.meta == a.meta
+
+
+def test_batch_of_seeds_equals_single_runs():
+    m = surrogates.FOWTModel()
+    batch = surrogates.simulate(m, 2, duration=30.0, seed=[1, 2, 3])
+    for s, rec in zip([1, 2, 3], batch, strict=True):
+        single = surrogates.simulate(m, 2, duration=30.0, seed=s)
+        assert rec.y.tobytes() == single.y.tobytes()
+
+
+def test_noise_is_added_only_when_asked():
+    m = surrogates.FOWTModel()
+    noisy, truth = surrogates.simulate(m, 1, duration=30.0, seed=0, return_truth=True)
+    clean = surrogates.simulate(m, 1, duration=30.0, seed=0, noise=False)
+    assert truth.y.tobytes() == clean.y.tobytes()
+    resid = noisy["TwHt5ALxt"] - truth["TwHt5ALxt"]
+    expect = np.hypot(m.noise.acceleration_white, m.noise.acceleration_coloured)
+    assert np.std(resid) == pytest.approx(expect, rel=0.15)
+
+
+# ------------------------------------------------------------------------------------------ bad input
+@pytest.mark.parametrize(
+    "call, word",
+    [
+        (lambda: surrogates.LoadCase(hs=-1.0, tp=8, wave_dir_deg=0, wind_speed=12, rotor_rpm=12.1,
+                                     turbulence_intensity=0.1, gamma=3.3), "hs"),
+        (lambda: surrogates.FOWTModel(effects={"quadratic_drags": 1.0}), "quadratic_drags"),
+        (lambda: surrogates.FOWTModel().with_effects(p_delta=float("nan")), "p_delta"),
+        (lambda: surrogates.simulate(surrogates.FOWTModel(), 7, duration=10.0, dt=0.5), "dt"),
+        (lambda: surrogates.simulate(surrogates.FOWTModel(), 7, duration=float("inf")), "duration"),
+        (lambda: surrogates.simulate(surrogates.FOWTModel(), 7, duration=10.0, dt=-0.01), "dt"),
+        (lambda: surrogates.simulate(surrogates.FOWTModel(), 13, duration=10.0), "13"),
+        (lambda: surrogates.simulate(surrogates.FOWTModel(), 7, duration=10.0, transient=float("nan")), "transient"),
+        (lambda: surrogates.FOWTModel(harmonics=surrogates.RotorHarmonics(thrust_3p=float("inf"))), "thrust_3p"),
+        (lambda: surrogates.simulate("not a model", 7, duration=10.0), "model"),
+    ],
+)
+def test_bad_input_raises_value_error_naming_the_argument(call, word):
+    with pytest.raises(ValueError, match=word):
+        call()
