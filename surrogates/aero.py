@@ -11,8 +11,9 @@ linearised about it:
 
 with ``v_hub`` the fore-aft velocity of the hub (the ``aero_damping`` effect). The baseline controller is
 the one Jonkman (2010) used for OC3 Hywind: constant generator torque above rated and the NREL 5 MW
-gain-scheduled PI collective-pitch loop on rotor speed, with its natural frequency lowered to 0.2 rad/s (near
-the platform pitch frequency) so that the platform pitch mode is not destabilised. The gains follow the
+gain-scheduled PI collective-pitch loop on rotor speed, with its natural frequency lowered well below the
+platform pitch frequency so that the platform pitch mode is not destabilised (Jonkman used 0.2 rad/s; this
+surrogate uses 0.1 rad/s, see ``RATED``). The gains follow the
 published design rule (Jonkman et al. 2009, section 7.4: dP/dbeta = -25.52 MW/rad at rated, gain-correction
 factor 1 / (1 + beta / 6.302336 deg)). Below rated the generator torque follows the optimal-tip-speed law and
 the pitch stays at fine pitch.
@@ -38,7 +39,11 @@ RATED = {
     "rotor_speed_rpm": 12.1,  # rpm
     "wind_speed": 11.4,  # m/s
     "min_pitch_rad": 0.0,
-    "pitch_controller_frequency": 0.2,  # rad/s, OC3 Hywind detuned (Jonkman 2010, section 7.2)
+    # rad/s. Jonkman (2010, section 7.2) detuned the OC3 Hywind loop from 0.6 to 0.2 rad/s, just below the
+    # platform pitch frequency (0.21 rad/s). In this surrogate (no radiation damping) 0.2 rad/s still leaves a
+    # coupled pitch-controller mode with negative damping between 11.4 and 13 m/s, so the loop is placed at
+    # half the platform pitch frequency, the rule of Larsen & Hanson (2007); every mode is then damped.
+    "pitch_controller_frequency": 0.1,
     "pitch_controller_damping": 0.7,  # -
     # gain scheduling of the NREL 5 MW baseline controller (Jonkman et al. 2009, section 7.4): sensitivity of
     # aerodynamic power to pitch at rated, and the pitch angle at which it has doubled
@@ -182,7 +187,9 @@ class OperatingPoint:
 
 
 @lru_cache(maxsize=128)
-def operating_point(wind_speed: float, rotor_rpm: float | None = None, drivetrain_inertia: float = 4.35e7) -> OperatingPoint:
+def operating_point(
+    wind_speed: float, rotor_rpm: float | None = None, drivetrain_inertia: float = 4.35e7
+) -> OperatingPoint:
     """Steady operating point of the NREL 5 MW with its baseline controller at a mean wind speed.
 
     Parameters

@@ -224,7 +224,8 @@ def load_oc3() -> OC3Data:
     ed_txt = (deck / "NRELOffshrBsline5MW_OC3Hywind_ElastoDyn.dat").read_text()
     blade_txt = (deck / "NRELOffshrBsline5MW_Blade.dat").read_text()
     bmi_txt = (
-        root / "sample_inputs" / "reference_turbines" / "07_nrel5mw_oc3hywind_spar" / "07_nrel5mw_oc3hywind_spar_tower.bmi"
+        root / "sample_inputs" / "reference_turbines" / "07_nrel5mw_oc3hywind_spar"
+        / "07_nrel5mw_oc3hywind_spar_tower.bmi"
     ).read_text()
 
     tw = _keyed_values(tower_txt)

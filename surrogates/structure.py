@@ -217,7 +217,8 @@ def build_structure(n_tower_strips: int = 80, n_fe_elements: int = 40) -> Struct
     tilt = d.shaft_tilt_rad
     shaft = np.array([np.cos(tilt), 0.0, -np.sin(tilt)])  # downwind along the tilted shaft
     apex = d.rotor_apex
-    nac_iner = np.diag([0.0, 0.0, d.nacelle_yaw_inertia - d.nacelle_mass * (d.nacelle_cm[0] ** 2 + d.nacelle_cm[1] ** 2)])
+    nac_offset2 = d.nacelle_cm[0] ** 2 + d.nacelle_cm[1] ** 2
+    nac_iner = np.diag([0.0, 0.0, d.nacelle_yaw_inertia - d.nacelle_mass * nac_offset2])  # about its own CM
     cone = d.precone_rad
     blades_cm = apex + shaft * (d.blade_first_moment / d.blade_mass) * np.sin(cone)  # precone < 0: upwind
     # Rotor inertia: polar J_r about the shaft, half of the blades' polar inertia about any diameter. The rotor
