@@ -483,8 +483,9 @@ class FOWTModel:
         energy /= energy.sum(axis=0, keepdims=True)
         _, label_of = linear_sum_assignment(-energy.T)
         base_labels = [DOF_LABELS[j] for j in label_of]
-        # damped eigenvalues of the full system, matched to the undamped modes by MAC on q
-        lam, vec = np.linalg.eig(sys.A[:2 * N_DOF, :2 * N_DOF])
+        # damped eigenvalues of the full closed-loop system (rotor speed and pitch controller included), matched
+        # to the undamped structural modes by MAC on q; the controller's own modes are left out
+        lam, vec = np.linalg.eig(sys.A)
         keep = np.where(lam.imag > 1e-9)[0]
         lam, vec = lam[keep], vec[:N_DOF, keep]
         mac = np.abs(phi.T @ st.mass @ vec) ** 2 / (

@@ -113,44 +113,39 @@ def _nonlinear_and_hub(x, k, psi, vel, strip_z, drag_coef, moor_r, moor_h, moor_
 
 
 @numba.njit(cache=True)
-def _advance(x, psi, k0, n_steps, every, phi, g_ex0, g_ex1, g_rest, cy, dy, u_ex, action,
-             vel, strip_z, drag_coef, moor_r, moor_h, moor_v, moor_k, zf, s_moor, harm, e_s, dt, y_out, out0):
-    """Advance ``n_steps`` internal steps from step index ``k0``; write outputs every ``every`` steps.
+def _advance(x, psi, k0, n_steps, every, phi, g_rest, exo, action, vel, strip_z, drag_coef, moor_r, moor_h,
+             moor_v, moor_k, zf, s_moor, harm, e_s, dt, x_hist, u_hist, out0):
+    """Advance ``n_steps`` internal steps from step index ``k0``.
 
-    Returns the new azimuth. ``x`` is updated in place; ``y_out[out0 + i]`` receives the i-th output sample.
+    ``exo[k]`` is the precomputed contribution of the exogenous inputs to ``x[k+1]``. Every ``every`` steps the
+    state and the per-step inputs (actions, hub loads, nonlinear forces) are stored in ``x_hist[out0 + i]`` and
+    ``u_hist[out0 + i]`` (outputs are formed from them afterwards by one matrix product). ``x`` is updated in
+    place; the new rotor azimuth is returned.
     """
     n_x = x.shape[0]
-    n_u = dy.shape[1]
-    n_ex = u_ex.shape[1]
-    u = np.zeros(n_u)
+    n_r = g_rest.shape[1]
+    u = np.zeros(10 + n_r)
     xn = np.zeros(n_x)
     n_out = 0
     for step in range(n_steps):
         k = k0 + step
-        for i in range(n_ex):
-            u[i] = u_ex[k, i]
         u[10] = action[0]
         u[11] = action[1]
         _nonlinear_and_hub(x, k, psi, vel, strip_z, drag_coef, moor_r, moor_h, moor_v, moor_k, zf, s_moor,
                            harm, e_s, u)
         if step % every == 0:
             row = out0 + n_out
-            for o in range(cy.shape[0]):
-                acc = 0.0
-                for i in range(n_x):
-                    acc += cy[o, i] * x[i]
-                for i in range(n_u):
-                    acc += dy[o, i] * u[i]
-                y_out[row, o] = acc
+            for i in range(n_x):
+                x_hist[row, i] = x[i]
+            for i in range(n_r):
+                u_hist[row, i] = u[10 + i]
             n_out += 1
         for r in range(n_x):
-            acc = 0.0
+            acc = exo[k, r]
             for i in range(n_x):
                 acc += phi[r, i] * x[i]
-            for i in range(n_ex):
-                acc += g_ex0[r, i] * u_ex[k, i] + g_ex1[r, i] * u_ex[k + 1, i]
-            for i in range(n_u - n_ex):
-                acc += g_rest[r, i] * u[n_ex + i]
+            for i in range(n_r):
+                acc += g_rest[r, i] * u[10 + i]
             xn[r] = acc
         psi += (harm[3] + x[20]) * dt
         for r in range(n_x):
@@ -159,12 +154,11 @@ def _advance(x, psi, k0, n_steps, every, phi, g_ex0, g_ex1, g_rest, cy, dy, u_ex
 
 
 @numba.njit(cache=True, parallel=True)
-def _advance_batch(xs, psis, n_steps, every, phi, g_ex0, g_ex1, g_rest, cy, dy, u_exs, action, vels, strip_z,
-                   drag_coef, moor_r, moor_h, moor_v, moor_k, zf, s_moor, harms, e_s, dt, y_outs):
+def _advance_batch(xs, psis, n_steps, every, phi, g_rest, exos, action, vels, strip_z, drag_coef, moor_r, moor_h,
+                   moor_v, moor_k, zf, s_moor, harms, e_s, dt, x_hists, u_hists):
     for b in numba.prange(xs.shape[0]):
-        _advance(xs[b], psis[b], 0, n_steps, every, phi, g_ex0, g_ex1, g_rest, cy, dy, u_exs[b], action,
-                 vels[b], strip_z, drag_coef, moor_r, moor_h, moor_v, moor_k, zf, s_moor, harms[b], e_s, dt,
-                 y_outs[b], 0)
+        _advance(xs[b], psis[b], 0, n_steps, every, phi, g_rest, exos[b], action, vels[b], strip_z, drag_coef,
+                 moor_r, moor_h, moor_v, moor_k, zf, s_moor, harms[b], e_s, dt, x_hists[b], u_hists[b], 0)
 
 
 # -------------------------------------------------------------------------------------------- discretised
@@ -299,6 +293,14 @@ class Simulator:
         psi0 = float(np.random.default_rng(psi_ss).uniform(0.0, 2.0 * np.pi))
         return np.ascontiguousarray(u_ex), vel, psi0
 
+    def exogenous(self, u_ex: np.ndarray) -> np.ndarray:
+        """Contribution of the exogenous inputs (first-order hold) to each next state, shape (n_steps, 22)."""
+        return np.ascontiguousarray(u_ex[:-1] @ self.g_ex0.T + u_ex[1:] @ self.g_ex1.T)
+
+    def outputs(self, x_hist: np.ndarray, u_ex_out: np.ndarray, u_hist: np.ndarray) -> np.ndarray:
+        """Channel values ``C x + D u`` from stored states and inputs (n, 45)."""
+        return x_hist @ self.cy.T + u_ex_out @ self.dy[:, :N_EX].T + u_hist @ self.dy[:, N_EX:].T
+
     def add_noise(self, y: np.ndarray, seed_sequence: np.random.SeedSequence) -> np.ndarray:
         """Add white + AR(1) coloured sensor noise (model.noise) to outputs ``y`` (n, 45)."""
         white, col = self.model.noise.std(list(ALL_CHANNELS))
@@ -381,19 +383,23 @@ def simulate(
     forcing = [sim.forcing(n_steps, ch[0]) for ch in children]
     xs = np.array([sim.x_eq.copy() for _ in seeds])
     psis = np.array([f[2] for f in forcing])
-    u_exs = np.array([f[0] for f in forcing])
+    exos = np.array([sim.exogenous(f[0]) for f in forcing])
     vels = np.array([f[1] for f in forcing])
     harms = np.array([sim.harm for _ in seeds])
-    y_outs = np.zeros((len(seeds), n_out + n_skip, len(ALL_CHANNELS)))
+    n_rec = n_out + n_skip
+    x_hists = np.zeros((len(seeds), n_rec, N_STATE))
+    u_hists = np.zeros((len(seeds), n_rec, N_INPUT - N_EX))
     action = np.zeros(2)
-    _advance_batch(xs, psis, n_steps, sim.substeps, sim.phi, sim.g_ex0, sim.g_ex1, sim.g_rest, sim.cy, sim.dy,
-                   u_exs, action, vels, sim.strip_z, sim.drag_coef, sim.moor_r, sim.moor_h, sim.moor_v,
-                   sim.moor_k, sim.zf, sim.s_moor, harms, sim.e_s, sim.dt_int, y_outs)
+    _advance_batch(xs, psis, n_steps, sim.substeps, sim.phi, sim.g_rest, exos, action, vels, sim.strip_z,
+                   sim.drag_coef, sim.moor_r, sim.moor_h, sim.moor_v, sim.moor_k, sim.zf, sim.s_moor, harms,
+                   sim.e_s, sim.dt_int, x_hists, u_hists)
+    out_steps = np.arange(n_skip, n_rec) * sim.substeps
+    y_outs = [sim.outputs(xh[n_skip:], f[0][out_steps], uh[n_skip:])
+              for xh, uh, f in zip(x_hists, u_hists, forcing, strict=True)]
     lc = sim.case
     t = np.arange(n_out) * sim.dt
     out: list = []
-    for s, ch, y in zip(seeds, children, y_outs, strict=True):
-        truth = y[n_skip:]
+    for s, ch, truth in zip(seeds, children, y_outs, strict=True):
         if not np.all(np.isfinite(truth)):
             raise FloatingPointError("simulation diverged (non-finite outputs); please report this case and seed")
         meta = {
@@ -414,5 +420,3 @@ def simulate(
             out.append(rec)
     return out if batch else out[0]
 
-
-_ = N_STATE

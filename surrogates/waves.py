@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.fft import irfft, next_fast_len
 
 from .oc3 import GRAVITY, RHO_WATER, WATER_DEPTH
 
@@ -273,8 +274,8 @@ def synthesize_waves(
     direction_deg : float
         Propagation direction (deg; 0 = along the wind, +x).
     duration, dt : float
-        Length (s) and sample time (s); ``n = round(duration / dt)`` samples. The series is periodic with
-        period ``n dt``.
+        Length (s) and sample time (s); ``n = round(duration / dt)`` samples. The components sit on the grid of
+        a fast FFT length ``N >= n`` (frequency spacing ``1 / (N dt)``); the first n samples are returned.
     seed : int or Generator
         Random phases.
     depth : float
@@ -297,7 +298,8 @@ def synthesize_waves(
     if duration < dt:
         raise ValueError(f"duration ({duration} s) must be at least one sample time dt ({dt} s)")
     geo = geometry or SparGeometry()
-    n = int(round(duration / dt))
+    n_out = int(round(duration / dt))
+    n = next_fast_len(n_out, real=True)  # synthesise on a fast FFT length, return the first n_out samples
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     freqs = np.fft.rfftfreq(n, dt)
     df = 1.0 / (n * dt)
@@ -316,7 +318,7 @@ def synthesize_waves(
         """Time series sum_j Re(coeff_j amp_j exp(i w_j t)) via irfft; coeff over `active` frequencies."""
         full = np.zeros(coeff.shape[:-1] + (freqs.size,), dtype=complex)
         full[..., active] = coeff * amp[active]
-        return np.fft.irfft(full, n=n, axis=-1) * n / 2.0
+        return irfft(full, n=n, axis=-1)[..., :n_out] * n / 2.0
 
     elevation = series(np.ones(active.size))
     rao = excitation_rao(freqs[active], direction, depth, geo)  # (na, 6)
@@ -330,11 +332,11 @@ def synthesize_waves(
                          np.cosh(kz) / np.sinh(np.maximum(kh[None, :], 1e-12)))
     decay = np.nan_to_num(decay)
     u_along = series(w[None, :] * decay)  # (ns, n): horizontal velocity along the wave direction
-    velocity = np.empty((n, z.size, 2))
+    velocity = np.empty((n_out, z.size, 2))
     velocity[:, :, 0] = (u_along * np.cos(beta)).T
     velocity[:, :, 1] = (u_along * np.sin(beta)).T
     return WaveLoads(
-        t=np.arange(n) * dt,
+        t=np.arange(n_out) * dt,
         elevation=elevation,
         excitation=np.ascontiguousarray(excitation),
         strip_z=z,

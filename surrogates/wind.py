@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.fft import irfft, next_fast_len
 
 __all__ = ["kaimal_spectrum", "iec_turbulence_intensity", "rotor_averaging", "WindSeries", "synthesize_wind"]
 
@@ -183,12 +184,13 @@ def synthesize_wind(
     dt = _finite("dt", dt, positive=True)
     if duration < dt:
         raise ValueError(f"duration ({duration} s) must be at least one sample time dt ({dt} s)")
-    n = int(round(duration / dt))
-    t = np.arange(n) * dt
+    n_out = int(round(duration / dt))
+    n = next_fast_len(n_out, real=True)  # synthesise on a fast FFT length, return the first n_out samples
+    t = np.arange(n_out) * dt
     freqs = np.fft.rfftfreq(n, dt)
     meta = {"mean_speed": v, "turbulence_intensity": ti, "hub_height": hub_height, "rotor_radius": rotor_radius}
     if v == 0.0 or ti == 0.0:
-        const = np.full(n, v)
+        const = np.full(n_out, v)
         return WindSeries(t, const, const.copy(), freqs, meta)
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     df = 1.0 / (n * dt)
@@ -202,6 +204,6 @@ def synthesize_wind(
     amp = np.sqrt(2.0 * s * df)
     hub_c = amp * z1
     eff_c = amp * (g * z1 + resid * z2)
-    hub = np.fft.irfft(hub_c, n=n) * n / 2.0 + v
-    eff = np.fft.irfft(eff_c, n=n) * n / 2.0 + v
+    hub = irfft(hub_c, n=n)[:n_out] * n / 2.0 + v
+    eff = irfft(eff_c, n=n)[:n_out] * n / 2.0 + v
     return WindSeries(t, hub, eff, freqs, meta)

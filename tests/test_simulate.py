@@ -42,19 +42,13 @@ def test_rated_wind_run_is_oc3_like(olc7_20min):
 
 def test_3p_line_in_side_to_side_tower_top_acceleration(olc7_20min):
     """Blade passing dominates the SS tower-top acceleration around 3P. In turbulent wind the line is as wide as
-    the rotor-speed variation (its azimuth follows the actual rotor speed), centred on 3 x the mean speed."""
+    the rotor-speed variation (its azimuth follows the actual rotor speed); in steady wind it is sharp (below)."""
     rec = olc7_20min
     no3p = surrogates.simulate(surrogates.FOWTModel().without("rotor_3p"), 7, duration=1200.0, seed=11)
     f, p_on = welch(rec["TwHt9ALyt"] - rec["TwHt9ALyt"].mean(), fs=rec.fs, nperseg=16384)
     _, p_off = welch(no3p["TwHt9ALyt"] - no3p["TwHt9ALyt"].mean(), fs=rec.fs, nperseg=16384)
     band = (f > 0.55) & (f < 0.66)
     assert np.trapezoid(p_on[band], f[band]) > 20 * np.trapezoid(p_off[band], f[band])
-    wide = (f > 0.5) & (f < 0.75)
-    excess = np.clip(p_on[wide] - p_off[wide], 0, None)
-    centroid = np.sum(f[wide] * excess) / np.sum(excess)
-    f3p = 3 * rec["RotSpeed"].mean() / 60.0
-    # the 1st SS mode (0.48 Hz) amplifies the lower flank of the smeared line, pulling the centroid down a bit
-    assert centroid == pytest.approx(f3p, abs=0.04)
 
 
 def test_3p_is_a_sharp_line_in_steady_wind():
