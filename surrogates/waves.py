@@ -206,15 +206,20 @@ def excitation_rao(
     out[:, 4] = m_along * np.cos(beta)
     # vertical Froude-Krylov: dynamic pressure rho g decay_p eta on the keel (up) and on the taper annulus (down)
     keel_area = np.pi * geo.lower_diameter**2 / 4.0
-    taper_area = np.pi * (geo.lower_diameter**2 - geo.upper_diameter**2) / 4.0
-    zt = 0.5 * (geo.taper_top + geo.taper_bottom)
 
     def p_at(zz: float) -> np.ndarray:
         if depth * np.max(k, initial=0.0) > 30:
             return RHO_WATER * GRAVITY * np.exp(k * zz)
         return RHO_WATER * GRAVITY * np.cosh(k * (zz + depth)) / np.cosh(k * depth)
 
-    out[:, 2] = p_at(geo.draft) * keel_area - p_at(zt) * taper_area
+    # taper: the annulus faces up, so the pressure pushes down; integrate p(z) dA(z) with Gauss-Legendre
+    xg, wg = np.polynomial.legendre.leggauss(16)
+    zg = 0.5 * (geo.taper_top + geo.taper_bottom) + 0.5 * (geo.taper_top - geo.taper_bottom) * xg
+    taper_slope = (geo.lower_diameter - geo.upper_diameter) / (geo.taper_top - geo.taper_bottom)  # -dD/dz
+    da_dz = -np.pi / 2.0 * geo.diameter(zg) * taper_slope
+    taper = sum(w_i * p_at(z_i) * (-d_i) for w_i, z_i, d_i in zip(wg, zg, da_dz, strict=True))
+    taper = taper * 0.5 * (geo.taper_top - geo.taper_bottom)
+    out[:, 2] = p_at(geo.draft) * keel_area - taper
     out[f == 0] = 0.0
     return out
 

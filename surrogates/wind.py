@@ -118,24 +118,28 @@ def rotor_averaging(f_hz: np.ndarray, mean_speed: float, rotor_radius: float = 6
     H2 : ndarray
         Auto-spectrum ratio of the rotor-averaged wind to the point wind (-).
     G : ndarray
-        Cross-spectrum ratio of hub point and rotor average (-).
+        Cross-spectrum ratio of hub point and rotor average (-), in closed form.
     """
     v = _finite("mean_speed", mean_speed, positive=True)
     lc = 8.1 * _lambda1(_finite("hub_height", hub_height, positive=True))
     f = np.asarray(f_hz, dtype=float)
     p, w = _disc_points(_finite("rotor_radius", rotor_radius, positive=True), n_rings, n_az)
     dist = np.hypot(p[:, None, 0] - p[None, :, 0], p[:, None, 1] - p[None, :, 1])
-    dist_c = np.hypot(p[:, 0], p[:, 1])
+    # a point's own cell: use the mean distance between two random points of a cell of equal area (~0.52 x its
+    # side) instead of 0, so the quadrature does not leave a floor of 1/n_points at high frequency
+    np.fill_diagonal(dist, 0.52 * np.sqrt(np.pi * rotor_radius**2 / len(p)))
     # evaluate on a log grid, interpolate (the functions are smooth)
     grid = np.concatenate([[0.0], np.logspace(-4, np.log10(max(f.max(initial=1.0), 1e-3)) + 0.01, 120)])
     h2 = np.empty(grid.size)
-    g = np.empty(grid.size)
     ww = np.outer(w, w)
     for i, fi in enumerate(grid):
         coh = np.exp(-12.0 * np.sqrt((fi * dist / v) ** 2 + (0.12 * dist / lc) ** 2))
         h2[i] = float(np.sum(ww * coh))
-        g[i] = float(np.sum(w * np.exp(-12.0 * np.sqrt((fi * dist_c / v) ** 2 + (0.12 * dist_c / lc) ** 2))))
-    return np.interp(np.abs(f), grid, h2), np.interp(np.abs(f), grid, g)
+    # hub point vs disc average: the coherence is exp(-a r) with r the distance from the centre, so the disc
+    # average has the closed form (2 / (a R)^2) (1 - exp(-a R) (1 + a R))
+    a_r = 12.0 * np.sqrt((np.abs(f) / v) ** 2 + (0.12 / lc) ** 2) * rotor_radius
+    g_exact = 2.0 / a_r**2 * (1.0 - np.exp(-a_r) * (1.0 + a_r))
+    return np.interp(np.abs(f), grid, h2), g_exact
 
 
 @dataclass(frozen=True)
