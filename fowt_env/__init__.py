@@ -1,3 +1,51 @@
-"""fowt-env: composition of the surrogate and the estimators (environment, experiments, CLI)."""
+"""fowt-env: the OC3 Hywind surrogate as a Gymnasium environment, sensor faults, virtual sensors and the CLI.
+
+Importing the package registers the environments:
+
+* ``fowt_env/Spar-v0`` -- full surrogate (all effects), OLC 7 by default, all 36 tower channels;
+* ``fowt_env/SparLinear-v0`` -- the linear model (``effects="none"``), same defaults;
+* ``fowt_env/SparScenarioA-v0`` (``B``, ``C``) -- the seed paper's virtual-sensing scenarios: its load case,
+  the 18-channel fore-aft plane and the scenario's fixed mask of hidden sensors.
+
+All take the keyword arguments of :class:`fowt_env.env.SparEnv`; episodes are truncated after
+``max_episode_steps`` (48,000 steps = 600 s at dt = 0.0125 s; pass ``max_episode_steps=`` to ``gymnasium.make``
+to change it).
+"""
+
+from gymnasium.envs.registration import register, registry
+
+from . import faults
+from .env import RewardConfig, SparEnv
+from .wrappers import VirtualSensorWrapper
 
 __version__ = "0.1.0"
+__all__ = ["SparEnv", "RewardConfig", "VirtualSensorWrapper", "faults", "make_scenario_env", "ENV_IDS"]
+
+MAX_EPISODE_STEPS = 48_000
+
+
+def make_scenario_env(name: str, **kwargs) -> SparEnv:
+    """A :class:`SparEnv` set up as the paper's scenario ``name`` (its OLC, FA plane, fixed hidden mask)."""
+    scenario = faults.Scenario(name)
+    extra = kwargs.pop("faults", None)
+    fault_list = [scenario] + faults.as_fault_list(extra)
+    kwargs.setdefault("case", scenario.olc)
+    kwargs.setdefault("plane", "FA")
+    return SparEnv(faults=fault_list, **kwargs)
+
+
+def _linear_env(**kwargs) -> SparEnv:
+    import surrogates
+
+    kwargs.setdefault("model", surrogates.FOWTModel(effects="none"))
+    return SparEnv(**kwargs)
+
+
+ENV_IDS = ["fowt_env/Spar-v0", "fowt_env/SparLinear-v0"] + [f"fowt_env/SparScenario{s}-v0" for s in "ABC"]
+
+if "fowt_env/Spar-v0" not in registry:
+    register(id="fowt_env/Spar-v0", entry_point="fowt_env.env:SparEnv", max_episode_steps=MAX_EPISODE_STEPS)
+    register(id="fowt_env/SparLinear-v0", entry_point="fowt_env:_linear_env", max_episode_steps=MAX_EPISODE_STEPS)
+    for _s in "ABC":
+        register(id=f"fowt_env/SparScenario{_s}-v0", entry_point="fowt_env:make_scenario_env",
+                 kwargs={"name": _s}, max_episode_steps=MAX_EPISODE_STEPS)

@@ -21,6 +21,7 @@ from .load_cases import LOAD_CASES, LoadCase, load_case
 from .model import FOWTModel, LinearSystem, ModalResult, RotorHarmonics, SensorNoise
 from .record import Record
 from .simulate import Simulator, simulate
+from .stream import StreamingSimulator
 
 __all__ = [
     "ALL_CHANNELS",
@@ -36,6 +37,7 @@ __all__ = [
     "RotorHarmonics",
     "SensorNoise",
     "Simulator",
+    "StreamingSimulator",
     "UNITS",
     "load_case",
     "simulate",

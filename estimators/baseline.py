@@ -1,0 +1,94 @@
+"""Trivial virtual sensors: the floor any estimator must beat, and the proof of the sensor protocol.
+
+The virtual-sensor protocol (used by ``fowt_env.VirtualSensorWrapper``)::
+
+    sensor.fit(Y_train, mask=None) -> sensor     # optional learning from a record (n_samples, n_channels)
+    sensor.reset()                               # start of a new stream
+    sensor.update(y, mask) -> estimate           # one sample in (NaN/any value where mask is False), full vector out
+    sensor.reconstruct(Y, mask) -> Y_hat         # a whole record, same as streaming update() sample by sample
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["HoldLastValue"]
+
+
+class HoldLastValue:
+    """Estimate a lost channel by its last available value (0.0 if it was never seen, or the training mean).
+
+    Parameters
+    ----------
+    fill : {"zero", "mean"}
+        What to report for a channel lost since the start of a stream: 0.0, or its mean in the training data
+        (needs :meth:`fit`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = HoldLastValue()
+    >>> s.reset()
+    >>> s.update(np.array([1.0, 2.0]), np.array([True, True]))
+    array([1., 2.])
+    >>> s.update(np.array([5.0, np.nan]), np.array([True, False]))
+    array([5., 2.])
+    """
+
+    def __init__(self, fill: str = "zero") -> None:
+        self.fill = fill
+
+    def fit(self, Y: np.ndarray, mask: np.ndarray | None = None) -> HoldLastValue:
+        """Learn the per-channel mean of the available training data (for ``fill="mean"``)."""
+        Y = np.asarray(Y, dtype=float)
+        if Y.ndim != 2:
+            raise ValueError(f"Y must be 2-D (n_samples, n_channels), got shape {Y.shape}")
+        m = np.isfinite(Y) if mask is None else (np.asarray(mask, dtype=bool) & np.isfinite(Y))
+        counts = m.sum(axis=0)
+        self.mean_ = np.where(counts > 0, np.where(m, Y, 0.0).sum(axis=0) / np.maximum(counts, 1), 0.0)
+        self.n_channels_ = Y.shape[1]
+        return self
+
+    def reset(self) -> None:
+        """Forget the held values."""
+        self._last: np.ndarray | None = None
+
+    def update(self, y: np.ndarray, mask: np.ndarray) -> np.ndarray:
+        """One sample: available channels pass through, lost ones keep their last available value.
+
+        Parameters
+        ----------
+        y : ndarray (n_channels,)
+            Measured values (ignored where ``mask`` is False; NaN there is fine).
+        mask : ndarray of bool (n_channels,)
+            True = available. A NaN where mask is True is treated as a dropout.
+
+        Returns
+        -------
+        ndarray (n_channels,)
+        """
+        y = np.asarray(y, dtype=float)
+        mask = np.asarray(mask, dtype=bool)
+        if y.ndim != 1 or mask.shape != y.shape:
+            raise ValueError(f"y and mask must be 1-D of the same length, got {y.shape} and {mask.shape}")
+        if not hasattr(self, "_last"):
+            self.reset()
+        if self._last is None:
+            if self.fill == "mean":
+                if not hasattr(self, "mean_"):
+                    raise ValueError("fill='mean' needs fit() first")
+                self._last = self.mean_.astype(float).copy()
+            elif self.fill == "zero":
+                self._last = np.zeros(y.size)
+            else:
+                raise ValueError(f"fill must be 'zero' or 'mean', got {self.fill!r}")
+        ok = mask & np.isfinite(y)
+        self._last[ok] = y[ok]
+        return self._last.copy()
+
+    def reconstruct(self, Y: np.ndarray, mask: np.ndarray) -> np.ndarray:
+        """A whole record (n_samples, n_channels), identical to streaming :meth:`update`."""
+        Y = np.asarray(Y, dtype=float)
+        mask = np.broadcast_to(np.asarray(mask, dtype=bool), Y.shape)
+        self.reset()
+        return np.array([self.update(y, m) for y, m in zip(Y, mask, strict=True)])

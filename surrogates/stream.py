@@ -1,0 +1,193 @@
+"""Step-by-step simulation with actions and bounded memory: the engine behind the Gymnasium environment.
+
+:class:`StreamingSimulator` advances the same compiled stepper as :func:`surrogates.simulate`, a few samples at a
+time, with collective-pitch and generator-torque offsets held between calls. Forcing is synthesised in chunks
+(default 600 s): each chunk is an independent FFT realisation, and consecutive chunks are joined over an
+overlap (default 30 s) with power-complementary weights ``cos``/``sin`` of a quarter period, so the joined
+forcing is continuous and keeps its variance and spectrum (up to a spectral leakage of the overlap's length).
+Memory is therefore independent of the episode length. Sensor noise is produced sample by sample (white plus
+AR(1) coloured with its state carried).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .channels import ALL_CHANNELS
+from .load_cases import LoadCase
+from .model import INPUT_BLOCKS, N_INPUT, N_STATE, FOWTModel
+from .simulate import N_EX, Simulator, _advance
+
+__all__ = ["StreamingSimulator"]
+
+
+class StreamingSimulator:
+    """Advance the surrogate in small steps with actions, forcing streamed in crossfaded chunks.
+
+    Parameters
+    ----------
+    model : FOWTModel
+    case : int or LoadCase or None
+    dt : float
+        Output sample time (s).
+    chunk_seconds : float
+        Length of each forcing realisation (s).
+    overlap_seconds : float
+        Crossfade between consecutive realisations (s).
+    warmup_seconds : float
+        Simulated (and discarded) at every reset, from the static equilibrium.
+
+    Examples
+    --------
+    >>> import numpy as np, surrogates
+    >>> sim = surrogates.StreamingSimulator(surrogates.FOWTModel(), 7)
+    >>> y0 = sim.reset(seed=1)
+    >>> noisy, truth = sim.advance(80, action=np.zeros(2))
+    >>> truth.shape
+    (80, 45)
+    """
+
+    def __init__(self, model: FOWTModel, case: int | LoadCase | None, dt: float = 0.0125,
+                 chunk_seconds: float = 600.0, overlap_seconds: float = 30.0, warmup_seconds: float = 30.0) -> None:
+        self.sim = Simulator(model, case, dt)
+        for name, value in (("chunk_seconds", chunk_seconds), ("overlap_seconds", overlap_seconds)):
+            if not np.isfinite(value) or value <= 0:
+                raise ValueError(f"{name} must be positive and finite, got {value!r}")
+        if not np.isfinite(warmup_seconds) or warmup_seconds < 0:
+            raise ValueError(f"warmup_seconds must be finite and >= 0, got {warmup_seconds!r}")
+        if overlap_seconds >= chunk_seconds:
+            raise ValueError("overlap_seconds must be shorter than chunk_seconds")
+        self.dt = self.sim.dt
+        self.substeps = self.sim.substeps
+        self.chunk = int(round(chunk_seconds / self.sim.dt_int))
+        self.overlap = max(1, int(round(overlap_seconds / self.sim.dt_int)))
+        self.warmup = int(round(warmup_seconds / self.dt))
+        self.channels = list(ALL_CHANNELS)
+        self._white, self._col = model.noise.std(self.channels)
+        self._ar = math.exp(-self.dt / max(model.noise.correlation_time, 1e-9))
+        self._seq: np.random.SeedSequence | None = None
+
+    # ---------------------------------------------------------------------------------------------- forcing
+    def _raw_chunk(self) -> tuple[np.ndarray, np.ndarray]:
+        assert self._seq is not None
+        child = self._seq.spawn(1)[0]
+        u_ex, vel, _ = self.sim.forcing(self.chunk + self.overlap, child)
+        return u_ex, vel
+
+    def _next_chunk(self) -> None:
+        """Make the next `chunk` steps of forcing (plus one sample for the hold), crossfaded with the previous."""
+        u_new, v_new = self._raw_chunk()
+        if self._tail is not None:
+            tail_u, tail_v = self._tail
+            n = self.overlap
+            theta = 0.5 * np.pi * (np.arange(n) + 0.5) / n
+            c, s = np.cos(theta), np.sin(theta)
+            hub_w = INPUT_BLOCKS["hub_wind"].start
+            mean = np.zeros(N_EX)
+            mean[0] = 1.0
+            if self.sim.case is not None and self.sim.case.wind_speed > 0:
+                mean[hub_w] = self.sim.case.wind_speed  # crossfade the turbulence, not the mean wind
+            u_head = (tail_u - mean) * c[:, None] + (u_new[:n] - mean) * s[:, None] + mean
+            v_head = tail_v * c[:, None, None] + v_new[:n] * s[:, None, None]
+            u_new = np.concatenate([u_head, u_new[n:]])
+            v_new = np.concatenate([v_head, v_new[n:]])
+        # keep `chunk + 1` samples for this chunk; the rest is the tail to crossfade into the next one
+        self._u = np.ascontiguousarray(u_new[: self.chunk + 1])
+        self._vel = np.ascontiguousarray(v_new[: self.chunk + 1])
+        self._exo = self.sim.exogenous(self._u)
+        self._tail = (u_new[self.chunk: self.chunk + self.overlap], v_new[self.chunk: self.chunk + self.overlap])
+        self._k = 0
+
+    # ------------------------------------------------------------------------------------------------- API
+    def reset(self, seed: int | np.random.SeedSequence | None = None) -> np.ndarray:
+        """Start again from the static equilibrium (then ``warmup_seconds`` of simulation).
+
+        Parameters
+        ----------
+        seed : int or SeedSequence
+            Seeds forcing, rotor azimuth and noise.
+
+        Returns
+        -------
+        ndarray (45,)
+            Noise-free channel values at the first sample after the warm-up.
+        """
+        self._seq = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+        psi_seq, noise_seq = self._seq.spawn(2)
+        self._noise_rng = np.random.default_rng(noise_seq)
+        self._ar_state = self._col * self._noise_rng.standard_normal(len(self.channels))
+        self.psi = float(np.random.default_rng(psi_seq).uniform(0.0, 2.0 * np.pi))
+        self.x = self.sim.x_eq.copy()
+        self.time = 0.0
+        self._tail = None
+        self._next_chunk()
+        self._x_hist = np.zeros((1, N_STATE))
+        self._u_hist = np.zeros((1, N_INPUT - N_EX))
+        if self.warmup:
+            self.advance(self.warmup, np.zeros(2), noise=False)
+        self.time = 0.0
+        return self.output()
+
+    def output(self) -> np.ndarray:
+        """Noise-free channel values at the current state (45,), with zero actions and current forcing."""
+        x_hist = np.zeros((1, N_STATE))
+        u_hist = np.zeros((1, N_INPUT - N_EX))
+        _advance(self.x.copy(), self.psi, self._k, 1, 1, self.sim.phi, self.sim.g_rest, self._exo, np.zeros(2),
+                 self._vel, self.sim.strip_z, self.sim.drag_coef, self.sim.moor_r, self.sim.moor_h, self.sim.moor_v,
+                 self.sim.moor_k, self.sim.zf, self.sim.s_moor, self.sim.harm, self.sim.e_s, self.sim.dt_int,
+                 x_hist, u_hist, 0)
+        return self.sim.outputs(x_hist, self._u[self._k: self._k + 1], u_hist)[0]
+
+    def advance(self, n_samples: int, action: np.ndarray, noise: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """Advance ``n_samples`` output samples holding ``action``.
+
+        Parameters
+        ----------
+        n_samples : int
+            Output samples to produce (each ``dt``).
+        action : ndarray (2,)
+            Collective-pitch offset (rad) and generator-torque offset (N·m, low-speed shaft).
+        noise : bool
+            Return noisy channels too (else the noisy array is the truth).
+
+        Returns
+        -------
+        noisy, truth : ndarray (n_samples, 45)
+            Channel values at the start of each sample interval.
+        """
+        act = np.ascontiguousarray(action, dtype=float)
+        out_x = np.empty((n_samples, N_STATE))
+        out_u = np.empty((n_samples, N_INPUT - N_EX))
+        u_rows = np.empty((n_samples, N_EX))
+        sim = self.sim
+        done = 0
+        while done < n_samples:
+            room = (self.chunk - self._k) // self.substeps
+            if room <= 0:
+                self._next_chunk()
+                continue
+            m = min(room, n_samples - done)
+            u_rows[done: done + m] = self._u[self._k: self._k + m * self.substeps: self.substeps]
+            self.psi = _advance(self.x, self.psi, self._k, m * self.substeps, self.substeps, sim.phi, sim.g_rest,
+                                self._exo, act, self._vel, sim.strip_z, sim.drag_coef, sim.moor_r, sim.moor_h,
+                                sim.moor_v, sim.moor_k, sim.zf, sim.s_moor, sim.harm, sim.e_s, sim.dt_int, out_x,
+                                out_u, done)
+            self._k += m * self.substeps
+            done += m
+        self.time += n_samples * self.dt
+        truth = sim.outputs(out_x, u_rows, out_u)
+        if not noise or (not np.any(self._white) and not np.any(self._col)):
+            return truth, truth
+        noisy = np.empty_like(truth)
+        for i in range(n_samples):
+            e = self._noise_rng.standard_normal((2, len(self.channels)))
+            self._ar_state = self._ar * self._ar_state + math.sqrt(1.0 - self._ar**2) * self._col * e[0]
+            noisy[i] = truth[i] + self._white * e[1] + self._ar_state
+        return noisy, truth
+
+    @property
+    def state(self) -> np.ndarray:
+        """Current state vector (22,), a copy."""
+        return self.x.copy()
