@@ -35,7 +35,8 @@ __all__ = [
 ]
 
 SCENARIOS: dict[str, dict] = {
-    "A": {"hidden": (2, 3, 5, 7, 11, 12, 14, 16), "olc": 5, "description": "massive failure: 8 sensors along the tower"},
+    "A": {"hidden": (2, 3, 5, 7, 11, 12, 14, 16), "olc": 5,
+          "description": "massive failure: 8 sensors along the tower"},
     "B": {"hidden": (0, 8, 9, 17), "olc": 7, "description": "boundary loss: tower base and top"},
     "C": {"hidden": (0, 8, 9, 17), "olc": 2, "description": "boundary loss in low waves"},
 }

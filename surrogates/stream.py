@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.signal import lfilter
 
 from .channels import ALL_CHANNELS
 from .load_cases import LoadCase
@@ -180,12 +181,12 @@ class StreamingSimulator:
         truth = sim.outputs(out_x, u_rows, out_u)
         if not noise or (not np.any(self._white) and not np.any(self._col)):
             return truth, truth
-        noisy = np.empty_like(truth)
-        for i in range(n_samples):
-            e = self._noise_rng.standard_normal((2, len(self.channels)))
-            self._ar_state = self._ar * self._ar_state + math.sqrt(1.0 - self._ar**2) * self._col * e[0]
-            noisy[i] = truth[i] + self._white * e[1] + self._ar_state
-        return noisy, truth
+        e = self._noise_rng.standard_normal((2, n_samples, len(self.channels)))
+        # AR(1) coloured part x_i = a x_{i-1} + sqrt(1 - a^2) sigma e_i, its state carried between calls
+        colored, _ = lfilter([math.sqrt(1.0 - self._ar**2)], [1.0, -self._ar], self._col * e[0], axis=0,
+                             zi=(self._ar * self._ar_state)[None, :])
+        self._ar_state = colored[-1].copy()
+        return truth + self._white * e[1] + colored, truth
 
     @property
     def state(self) -> np.ndarray:
