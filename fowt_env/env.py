@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -203,6 +204,11 @@ class SparEnv(gym.Env):
     # ---------------------------------------------------------------------------------------------- helpers
     def _measure(self, noisy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Apply the faults sample by sample; return the last measured vector and mask (observed channels)."""
+        if not self.faults:
+            self._sample += noisy.shape[0]
+            y = noisy[-1, self._idx]
+            mask = np.isfinite(y)
+            return np.where(mask, y, 0.0), mask
         y = mask = None
         for row in noisy:
             y = row[self._idx].copy()
@@ -222,11 +228,12 @@ class SparEnv(gym.Env):
         a = np.asarray(action, dtype=float)
         if a.shape != (2,):
             raise ValueError(f"action must have shape (2,) [pitch, torque], got {a.shape}")
-        if not np.all(np.isfinite(a)):
+        a0, a1 = float(a[0]), float(a[1])
+        if not (math.isfinite(a0) and math.isfinite(a1)):
             raise ValueError(f"action must be finite, got {a}")
-        if np.any(np.abs(a) > 1.0 + 1e-6):
+        if abs(a0) > 1.0 + 1e-6 or abs(a1) > 1.0 + 1e-6:
             raise ValueError(f"action must lie in [-1, 1] (normalised pitch and torque offsets), got {a}")
-        return np.array([a[0] * self.max_pitch_offset, a[1] * self.max_torque_offset]), a
+        return np.array([a0 * self.max_pitch_offset, a1 * self.max_torque_offset]), a
 
     def electrical_power(self, truth: np.ndarray, torque_offset: float) -> float:
         """Electrical power (W) from rotor speed and generator torque (baseline + offset)."""
@@ -258,8 +265,11 @@ class SparEnv(gym.Env):
         noisy, truth = self._sim.advance(self.control_steps, act_phys, noise=self.noise)
         self._step += 1
         last = truth[-1]
-        finite = bool(np.all(np.isfinite(last)) and np.all(np.isfinite(self._sim.x)))
-        y, mask = self._measure(np.nan_to_num(noisy, nan=0.0, posinf=0.0, neginf=0.0) if not finite else noisy)
+        finite = math.isfinite(float(last.sum())) and math.isfinite(float(self._sim.x.sum()))
+        if not finite:
+            noisy = np.nan_to_num(noisy, nan=0.0, posinf=0.0, neginf=0.0)
+            last = np.nan_to_num(last, nan=0.0, posinf=0.0, neginf=0.0)
+        y, mask = self._measure(noisy)
         terminated = (not finite) or abs(last[self._i_pitch]) > self.max_pitch_deg
         truncated = self.episode_seconds is not None and self._sim.time >= self.episode_seconds - 1e-9
         power = self.electrical_power(last, act_phys[1]) if finite else 0.0
@@ -275,10 +285,10 @@ class SparEnv(gym.Env):
         else:
             reward = -1e3
         info = {
-            "truth": np.nan_to_num(last[self._idx]),
+            "truth": last[self._idx],
             "time": self._sim.time,
             "power": power,
-            "platform_pitch_deg": float(np.nan_to_num(last[self._i_pitch])),
+            "platform_pitch_deg": float(last[self._i_pitch]),
         }
         self._last = {"truth_all": last, "y": y, "mask": mask, "estimate": self._last.get("estimate")}
         if self.render_mode == "human":

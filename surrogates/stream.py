@@ -68,6 +68,9 @@ class StreamingSimulator:
         self.channels = list(ALL_CHANNELS)
         self._white, self._col = model.noise.std(self.channels)
         self._ar = math.exp(-self.dt / max(model.noise.correlation_time, 1e-9))
+        self._ar_gain = math.sqrt(1.0 - self._ar**2) * self._col
+        self._noisy = bool(np.any(self._white) or np.any(self._col))
+        self._cd = np.ascontiguousarray(np.hstack([self.sim.cy, self.sim.dy]))  # outputs of [x | u]
         self._seq: np.random.SeedSequence | None = None
 
     # ---------------------------------------------------------------------------------------------- forcing
@@ -159,10 +162,11 @@ class StreamingSimulator:
             Channel values at the start of each sample interval.
         """
         act = np.ascontiguousarray(action, dtype=float)
-        out_x = np.empty((n_samples, N_STATE))
-        out_u = np.empty((n_samples, N_INPUT - N_EX))
-        u_rows = np.empty((n_samples, N_EX))
         sim = self.sim
+        # one buffer [x | exogenous u | per-step u] per output sample, so the outputs are a single product
+        buf = np.empty((n_samples, self._cd.shape[1]))
+        out_x = buf[:, :N_STATE]
+        out_u = buf[:, N_STATE + N_EX:]
         done = 0
         while done < n_samples:
             room = (self.chunk - self._k) // self.substeps
@@ -170,7 +174,7 @@ class StreamingSimulator:
                 self._next_chunk()
                 continue
             m = min(room, n_samples - done)
-            u_rows[done: done + m] = self._u[self._k: self._k + m * self.substeps: self.substeps]
+            buf[done: done + m, N_STATE: N_STATE + N_EX] = self._u[self._k: self._k + m * self.substeps: self.substeps]
             self.psi = _advance(self.x, self.psi, self._k, m * self.substeps, self.substeps, sim.phi, sim.g_rest,
                                 self._exo, act, self._vel, sim.strip_z, sim.drag_coef, sim.moor_r, sim.moor_h,
                                 sim.moor_v, sim.moor_k, sim.zf, sim.s_moor, sim.harm, sim.e_s, sim.dt_int, out_x,
@@ -178,13 +182,20 @@ class StreamingSimulator:
             self._k += m * self.substeps
             done += m
         self.time += n_samples * self.dt
-        truth = sim.outputs(out_x, u_rows, out_u)
-        if not noise or (not np.any(self._white) and not np.any(self._col)):
+        truth = buf @ self._cd.T
+        if not noise or not self._noisy:
             return truth, truth
         e = self._noise_rng.standard_normal((2, n_samples, len(self.channels)))
         # AR(1) coloured part x_i = a x_{i-1} + sqrt(1 - a^2) sigma e_i, its state carried between calls
-        colored, _ = lfilter([math.sqrt(1.0 - self._ar**2)], [1.0, -self._ar], self._col * e[0], axis=0,
-                             zi=(self._ar * self._ar_state)[None, :])
+        if n_samples <= 8:
+            colored = np.empty((n_samples, len(self.channels)))
+            state = self._ar_state
+            for i in range(n_samples):
+                state = self._ar * state + self._ar_gain * e[0, i]
+                colored[i] = state
+        else:
+            colored, _ = lfilter([1.0], [1.0, -self._ar], self._ar_gain * e[0], axis=0,
+                                 zi=(self._ar * self._ar_state)[None, :])
         self._ar_state = colored[-1].copy()
         return truth + self._white * e[1] + colored, truth
 
