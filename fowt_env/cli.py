@@ -8,6 +8,7 @@ Examples
     fowt-env simulate --case 7 --duration 1200 --seed 3 --out olc7.npz
     fowt-env simulate --case 4 --effects none --no-noise --out linear.npz
     fowt-env modes --case 7 --json modes.json
+    fowt-env episode --case 5 --plane FA --fault scenario:A --fault dropout:0.1:2 --duration 120 --out ep.npz
 """
 
 from __future__ import annotations
@@ -72,6 +73,78 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     return 0
 
 
+def _parse_faults(specs: list[str]):
+    """``dropout:RATE:BURST_S``, ``scenario:A``, ``mask:CH1,CH2``, ``stuck:CH:START``, ``spike:RATE:AMP``,
+    ``drift:CH:RATE``, ``noiseburst:CH:STD:START:DURATION``."""
+    from . import faults as F
+
+    out = []
+    for spec in specs:
+        kind, *args = spec.split(":")
+        try:
+            if kind == "dropout":
+                out.append(F.RandomDropout(float(args[0]), float(args[1])))
+            elif kind == "scenario":
+                out.append(F.Scenario(args[0]))
+            elif kind == "mask":
+                out.append(F.FixedMask(args[0].split(",")))
+            elif kind == "stuck":
+                out.append(F.Stuck(args[0].split(","), start=float(args[1]) if len(args) > 1 else 0.0))
+            elif kind == "spike":
+                out.append(F.Spike(float(args[0]), float(args[1])))
+            elif kind == "drift":
+                out.append(F.Drift(args[0].split(","), rate=float(args[1])))
+            elif kind == "noiseburst":
+                out.append(F.NoiseBurst(args[0].split(","), std=float(args[1]), start=float(args[2]),
+                                        duration=float(args[3])))
+            else:
+                raise SystemExit(f"fowt-env: --fault: unknown kind {kind!r} (dropout, scenario, mask, stuck, spike, "
+                                 "drift, noiseburst)")
+        except (IndexError, ValueError) as exc:
+            raise SystemExit(f"fowt-env: --fault {spec!r}: {exc or 'missing arguments'}") from exc
+    return out
+
+
+def _cmd_episode(args: argparse.Namespace) -> int:
+    import surrogates
+
+    from .env import SparEnv
+
+    env = SparEnv(case=_case(args.case), dt=args.dt, plane=args.plane,
+                  faults=_parse_faults(args.fault or []), model=surrogates.FOWTModel(_parse_effects(args.effects)))
+    n = int(round(args.duration / env.control_dt))
+    obs, info = env.reset(seed=args.seed)
+    meas, truth, t = [], [], []
+
+    def keep(o, inf):
+        meas.append(np.where(o["mask"].astype(bool), o["sensors"], np.nan))
+        truth.append(inf["truth"])
+        t.append(inf["time"])
+
+    keep(obs, info)
+    zero = np.zeros(2, dtype=np.float32)
+    t0 = time.perf_counter()
+    for _ in range(n - 1):
+        obs, _, term, _, info = env.step(zero)
+        keep(obs, info)
+        if term:
+            print("episode terminated (physical failure)")
+            break
+    wall = time.perf_counter() - t0
+    meta = {"source": "fowt-env episode", "case": env.case.to_dict(), "seed": args.seed,
+            "faults": [repr(f) for f in env.faults], "plane": args.plane, "dt": env.dt}
+    units = surrogates.FOWTModel.units(env.channels)
+    measured = surrogates.Record(np.array(t), np.array(meas), env.channels, units, {**meta, "kind": "measured"})
+    true_rec = surrogates.Record(np.array(t), np.array(truth), env.channels, units, {**meta, "kind": "truth"})
+    out = Path(args.out)
+    p1 = measured.save(out)
+    p2 = true_rec.save(out.with_name(out.stem + "_truth" + out.suffix))
+    lost = np.isnan(measured.y).mean()
+    print(f"{len(t)} steps ({t[-1]:.1f} s) in {wall:.2f} s; {100 * lost:.1f} % of samples lost")
+    print(f"wrote {p1} (measured, NaN where lost)\nwrote {p2} (noise-free truth)")
+    return 0
+
+
 def _stats_table(rec, names: list[str]) -> str:
     rows = [f"{'channel':<12}{'unit':>8}{'mean':>12}{'std':>12}{'min':>12}{'max':>12}"]
     for n in names:
@@ -133,6 +206,19 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--no-noise", action="store_true", help="noise-free sensors")
     s.add_argument("--out", required=True, help="output .npz file")
     s.set_defaults(func=_cmd_simulate)
+
+    e = sub.add_parser("episode", help="run an environment episode under sensor faults and save the records")
+    e.add_argument("--case", default="7", help="OLC number 1-12")
+    e.add_argument("--duration", type=float, default=600.0, help="seconds (default 600)")
+    e.add_argument("--dt", type=float, default=0.0125)
+    e.add_argument("--plane", choices=["FA", "SS"], default=None, help="18 channels of one plane (default all 36)")
+    e.add_argument("--fault", action="append", metavar="SPEC",
+                   help="repeatable: dropout:RATE:BURST_S | scenario:A|B|C | mask:CH,CH | stuck:CH:START | "
+                        "spike:RATE:AMP | drift:CH:RATE | noiseburst:CH:STD:START:DURATION")
+    e.add_argument("--effects", default="all")
+    e.add_argument("--seed", type=int, default=0)
+    e.add_argument("--out", required=True, help="output .npz (the truth goes to *_truth.npz)")
+    e.set_defaults(func=_cmd_episode)
 
     m = sub.add_parser("modes", help="modal frequencies and damping of the linearised model")
     m.add_argument("--case", default=None, help="OLC number (default: parked, still water)")
