@@ -224,3 +224,17 @@ def _resident_bytes() -> int:
 
     with open("/proc/self/statm") as fh:
         return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def test_terminates_on_extreme_platform_pitch():
+    env = gym.make("fowt_env/Spar-v0", max_pitch_deg=1.0)  # the mean pitch at rated wind is ~4 deg
+    env.reset(seed=0)
+    _, reward, terminated, truncated, info = env.step(np.zeros(2, dtype=np.float32))
+    assert terminated and not truncated and abs(info["platform_pitch_deg"]) > 1.0
+
+
+def test_control_dt_holds_actions_for_several_samples():
+    env = fowt_env.SparEnv(control_dt=0.25)
+    env.reset(seed=0)
+    _, _, _, _, info = env.step(np.zeros(2, dtype=np.float32))
+    assert env.control_steps == 20 and info["time"] == pytest.approx(0.25 + 0.0125)
