@@ -31,6 +31,7 @@ from .mooring import mooring_table
 from .oc3 import RHO_WATER
 from .record import Record
 from .structure import N_DOF
+from .validation import check_number
 from .waves import SparGeometry, synthesize_waves
 from .wind import synthesize_wind
 
@@ -180,16 +181,6 @@ def _discretise(sys: LinearSystem, dt: float) -> _Discrete:
     return _Discrete(np.ascontiguousarray(phi), g_ex0, g_ex1, np.ascontiguousarray(gam1[:, N_EX:]))
 
 
-def _check_positive(name: str, value: float) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a number, got {value!r}") from exc
-    if not np.isfinite(v) or v <= 0:
-        raise ValueError(f"{name} must be positive and finite, got {value!r}")
-    return v
-
-
 class Simulator:
     """Everything that does not depend on the seed: discretised system, nonlinear-effect tables, outputs.
 
@@ -210,7 +201,7 @@ class Simulator:
     def __init__(self, model: FOWTModel, case: int | LoadCase | None, dt: float = 0.0125) -> None:
         if not isinstance(model, FOWTModel):
             raise ValueError(f"model must be a surrogates.FOWTModel, got {type(model).__name__}")
-        dt = _check_positive("dt", dt)
+        dt = check_number("dt", dt, positive=True)
         if dt > MAX_SAMPLE_TIME:
             raise ValueError(
                 f"dt={dt} s is too large: sampling must resolve the 2nd tower modes (~2.6 Hz); use dt <= "
@@ -359,7 +350,7 @@ def simulate(
     ValueError
         Non-positive or non-finite duration/dt/transient, dt too large, a bad case or model.
     """
-    duration = _check_positive("duration", duration)
+    duration = check_number("duration", duration, positive=True)
     if not np.isfinite(transient) or transient < 0:
         raise ValueError(f"transient must be finite and >= 0 (s), got {transient!r}")
     batch = not np.isscalar(seed)

@@ -17,22 +17,9 @@ import numpy as np
 from scipy.fft import irfft, next_fast_len
 
 from .oc3 import GRAVITY, RHO_WATER, WATER_DEPTH
+from .validation import check_number
 
 __all__ = ["jonswap_spectrum", "wave_number", "SparGeometry", "WaveLoads", "synthesize_waves", "excitation_rao"]
-
-
-def _finite(name: str, value: float, *, positive: bool = False, nonneg: bool = False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a number, got {value!r}") from exc
-    if not np.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    if positive and v <= 0:
-        raise ValueError(f"{name} must be > 0, got {value!r}")
-    if nonneg and v < 0:
-        raise ValueError(f"{name} must be >= 0, got {value!r}")
-    return v
 
 
 def jonswap_spectrum(f_hz: np.ndarray, hs: float, tp: float, gamma: float = 3.3) -> np.ndarray:
@@ -58,9 +45,9 @@ def jonswap_spectrum(f_hz: np.ndarray, hs: float, tp: float, gamma: float = 3.3)
     ndarray
         Spectral density (m²/Hz).
     """
-    hs = _finite("hs", hs, nonneg=True)
-    tp = _finite("tp", tp, positive=True)
-    gamma = _finite("gamma", gamma)
+    hs = check_number("hs", hs, nonneg=True)
+    tp = check_number("tp", tp, positive=True)
+    gamma = check_number("gamma", gamma)
     if not 1.0 <= gamma <= 10.0:
         raise ValueError(f"gamma must be between 1 and 10, got {gamma!r}")
     f = np.asarray(f_hz, dtype=float)
@@ -92,7 +79,7 @@ def wave_number(omega: np.ndarray, depth: float = WATER_DEPTH) -> np.ndarray:
     ndarray
         Wave number (rad/m).
     """
-    depth = _finite("depth", depth, positive=True)
+    depth = check_number("depth", depth, positive=True)
     w = np.asarray(omega, dtype=float)
     k0 = w**2 / GRAVITY
     # start from the deep-water value or the shallow-water one, whichever is larger (Newton converges from above)
@@ -180,7 +167,7 @@ def excitation_rao(
         [Fx, Fy, Fz, Mx, My, Mz] per metre of wave amplitude (N/m, N·m/m), complex.
     """
     geo = geometry or SparGeometry()
-    beta = np.deg2rad(_finite("direction_deg", direction_deg))
+    beta = np.deg2rad(check_number("direction_deg", direction_deg))
     f = np.atleast_1d(np.asarray(f_hz, dtype=float))
     w = 2 * np.pi * f
     k = wave_number(w, depth)
@@ -295,11 +282,11 @@ def synthesize_waves(
     -------
     WaveLoads
     """
-    hs = _finite("hs", hs, nonneg=True)
-    tp = _finite("tp", tp, positive=True)
-    duration = _finite("duration", duration, positive=True)
-    dt = _finite("dt", dt, positive=True)
-    direction = _finite("direction_deg", direction_deg)
+    hs = check_number("hs", hs, nonneg=True)
+    tp = check_number("tp", tp, positive=True)
+    duration = check_number("duration", duration, positive=True)
+    dt = check_number("dt", dt, positive=True)
+    direction = check_number("direction_deg", direction_deg)
     if duration < dt:
         raise ValueError(f"duration ({duration} s) must be at least one sample time dt ({dt} s)")
     geo = geometry or SparGeometry()

@@ -13,21 +13,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.fft import irfft, next_fast_len
 
+from .validation import check_number
+
 __all__ = ["kaimal_spectrum", "iec_turbulence_intensity", "rotor_averaging", "WindSeries", "synthesize_wind"]
-
-
-def _finite(name: str, value: float, *, positive: bool = False, nonneg: bool = False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a number, got {value!r}") from exc
-    if not np.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    if positive and v <= 0:
-        raise ValueError(f"{name} must be > 0, got {value!r}")
-    if nonneg and v < 0:
-        raise ValueError(f"{name} must be >= 0, got {value!r}")
-    return v
 
 
 def _lambda1(hub_height: float) -> float:
@@ -57,11 +45,11 @@ def kaimal_spectrum(f_hz: np.ndarray, mean_speed: float, turbulence_intensity: f
     ndarray
         Spectral density (m²/s²/Hz).
     """
-    v = _finite("mean_speed", mean_speed, positive=True)
-    ti = _finite("turbulence_intensity", turbulence_intensity, nonneg=True)
+    v = check_number("mean_speed", mean_speed, positive=True)
+    ti = check_number("turbulence_intensity", turbulence_intensity, nonneg=True)
     if ti >= 1:
         raise ValueError(f"turbulence_intensity must be < 1, got {turbulence_intensity!r}")
-    length = 8.1 * _lambda1(_finite("hub_height", hub_height, positive=True))
+    length = 8.1 * _lambda1(check_number("hub_height", hub_height, positive=True))
     f = np.asarray(f_hz, dtype=float)
     sigma = ti * v
     return 4.0 * sigma**2 * (length / v) / (1.0 + 6.0 * np.abs(f) * length / v) ** (5.0 / 3.0)
@@ -77,7 +65,7 @@ def iec_turbulence_intensity(mean_speed: float, turbulence_class: str = "B") -> 
     turbulence_class : {"A", "B", "C"}
         I_ref = 0.16, 0.14, 0.12.
     """
-    v = _finite("mean_speed", mean_speed, positive=True)
+    v = check_number("mean_speed", mean_speed, positive=True)
     refs = {"A": 0.16, "B": 0.14, "C": 0.12}
     if turbulence_class not in refs:
         raise ValueError(f"turbulence_class must be one of {sorted(refs)}, got {turbulence_class!r}")
@@ -120,10 +108,10 @@ def rotor_averaging(f_hz: np.ndarray, mean_speed: float, rotor_radius: float = 6
     G : ndarray
         Cross-spectrum ratio of hub point and rotor average (-), in closed form.
     """
-    v = _finite("mean_speed", mean_speed, positive=True)
-    lc = 8.1 * _lambda1(_finite("hub_height", hub_height, positive=True))
+    v = check_number("mean_speed", mean_speed, positive=True)
+    lc = 8.1 * _lambda1(check_number("hub_height", hub_height, positive=True))
     f = np.asarray(f_hz, dtype=float)
-    p, w = _disc_points(_finite("rotor_radius", rotor_radius, positive=True), n_rings, n_az)
+    p, w = _disc_points(check_number("rotor_radius", rotor_radius, positive=True), n_rings, n_az)
     dist = np.hypot(p[:, None, 0] - p[None, :, 0], p[:, None, 1] - p[None, :, 1])
     # a point's own cell: use the mean distance between two random points of a cell of equal area (~0.52 x its
     # side) instead of 0, so the quadrature does not leave a floor of 1/n_points at high frequency
@@ -180,12 +168,12 @@ def synthesize_wind(
     -------
     WindSeries
     """
-    v = _finite("mean_speed", mean_speed, nonneg=True)
-    ti = _finite("turbulence_intensity", turbulence_intensity, nonneg=True)
+    v = check_number("mean_speed", mean_speed, nonneg=True)
+    ti = check_number("turbulence_intensity", turbulence_intensity, nonneg=True)
     if ti >= 1:
         raise ValueError(f"turbulence_intensity must be < 1, got {turbulence_intensity!r}")
-    duration = _finite("duration", duration, positive=True)
-    dt = _finite("dt", dt, positive=True)
+    duration = check_number("duration", duration, positive=True)
+    dt = check_number("dt", dt, positive=True)
     if duration < dt:
         raise ValueError(f"duration ({duration} s) must be at least one sample time dt ({dt} s)")
     n_out = int(round(duration / dt))
