@@ -335,9 +335,9 @@ def simulate(
         Simulated time discarded before the record starts (s), so that the start-up from the static
         equilibrium has decayed.
     noise : bool
-        Add the model's sensor noise. The noise-free signals are in ``record.meta`` only if ``return_truth``.
+        Add the model's sensor noise (:class:`surrogates.SensorNoise`).
     return_truth : bool
-        If True, also return the noise-free record: ``(noisy, truth)`` (lists of pairs for a batch).
+        If True, return ``(noisy, truth)`` pairs: the noise-free record alongside (a list of pairs for a batch).
 
     Returns
     -------
