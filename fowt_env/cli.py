@@ -9,6 +9,7 @@ Examples
     fowt-env simulate --case 4 --effects none --no-noise --out linear.npz
     fowt-env modes --case 7 --json modes.json
     fowt-env episode --case 5 --plane FA --fault scenario:A --fault dropout:0.1:2 --duration 120 --out ep.npz
+    fowt-env discrepancy measured.npz --case 7 --model-effects aero_damping=0 --json report.json --plot figs
 """
 
 from __future__ import annotations
@@ -145,6 +146,26 @@ def _cmd_episode(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_discrepancy(args: argparse.Namespace) -> int:
+    import surrogates
+
+    from . import discrepancy
+
+    measured = surrogates.Record.load(args.measured)
+    model = surrogates.FOWTModel(_parse_effects(args.model_effects))
+    cands = args.candidates.split(",") if args.candidates else None
+    t0 = time.perf_counter()
+    rep = discrepancy.run(measured, model, _case(args.case), seed=args.seed, candidates=cands, n_seeds=args.seeds)
+    print(rep.summary())
+    print(f"({time.perf_counter() - t0:.1f} s)")
+    if args.json:
+        Path(args.json).write_text(json.dumps(rep.to_dict(), indent=2))
+        print(f"wrote {args.json}")
+    if args.plot:
+        print(f"wrote {rep.plot(Path(args.plot) / 'discrepancy.png')}")
+    return 0
+
+
 def _stats_table(rec, names: list[str]) -> str:
     rows = [f"{'channel':<12}{'unit':>8}{'mean':>12}{'std':>12}{'min':>12}{'max':>12}"]
     for n in names:
@@ -180,6 +201,16 @@ def _cmd_demo(args: argparse.Namespace) -> int:
                      modes=list(zip(modes.labels, modes.frequencies_hz, strict=True)), rotor_rpm=case.rotor_rpm,
                      title=f"Tower-top acceleration, {case.name} (modes: parked linear model)")
     print(f"\nwrote {path}\nwrote {fig}")
+    if args.skip_discrepancy:
+        return 0
+    from . import discrepancy
+
+    print("\nDiscrepancy round trip: the 'measurement' above has aerodynamic damping; the candidate model lacks it.")
+    t0 = time.perf_counter()
+    coarse = surrogates.simulate(model, case, duration=args.duration, dt=0.05, seed=args.seed)
+    rep = discrepancy.run(coarse, model.without("aero_damping"), case, n_seeds=3)
+    print(rep.summary())
+    print(f"wrote {rep.plot(out / 'discrepancy.png')} ({time.perf_counter() - t0:.0f} s)")
     return 0
 
 
@@ -195,6 +226,7 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--case", default="7", help="OLC number 1-12 (default 7: Hs 3 m, Tp 10 s, rated wind)")
     d.add_argument("--duration", type=float, default=600.0, help="simulated seconds (default 600)")
     d.add_argument("--seed", type=int, default=0)
+    d.add_argument("--skip-discrepancy", action="store_true", help="skip the discrepancy round trip")
     d.set_defaults(func=_cmd_demo)
 
     s = sub.add_parser("simulate", help="simulate a load case and save the record (.npz + JSON header)")
@@ -219,6 +251,17 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--seed", type=int, default=0)
     e.add_argument("--out", required=True, help="output .npz (the truth goes to *_truth.npz)")
     e.set_defaults(func=_cmd_episode)
+
+    q = sub.add_parser("discrepancy", help="find and name the physical effect a model misses in a measured record")
+    q.add_argument("measured", help="measured record (.npz written by fowt-env or surrogates.Record.save)")
+    q.add_argument("--case", required=True, help="OLC number of the measured conditions")
+    q.add_argument("--model-effects", default="all", help="candidate model: 'all', 'none' or name=strength,...")
+    q.add_argument("--candidates", default=None, help="comma-separated effects to consider (default all)")
+    q.add_argument("--seeds", type=int, default=4, help="model simulations per setting (default 4)")
+    q.add_argument("--seed", type=int, default=None)
+    q.add_argument("--json", default=None, help="write the report as JSON")
+    q.add_argument("--plot", default=None, help="folder for the figure")
+    q.set_defaults(func=_cmd_discrepancy)
 
     m = sub.add_parser("modes", help="modal frequencies and damping of the linearised model")
     m.add_argument("--case", default=None, help="OLC number (default: parked, still water)")
