@@ -207,8 +207,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
     print("\nDiscrepancy round trip: the 'measurement' above has aerodynamic damping; the candidate model lacks it.")
     t0 = time.perf_counter()
-    coarse = surrogates.simulate(model, case, duration=args.duration, dt=0.05, seed=args.seed)
-    rep = discrepancy.run(coarse, model.without("aero_damping"), case, n_seeds=3)
+    rep = discrepancy.run(rec, model.without("aero_damping"), case, n_seeds=3)
     print(rep.summary())
     print(f"wrote {rep.plot(out / 'discrepancy.png')} ({time.perf_counter() - t0:.0f} s)")
     return 0

@@ -46,6 +46,15 @@ SHAPE_CHANNELS = ("PtfmSurge", "PtfmPitch", "TwHt1MLyt")
 LOG_FLOOR = 0.05  # minimum scatter of a log band power (~5 %)
 MEAN_FLOOR = 0.02  # minimum scatter of a mean, relative to its magnitude (2 %)
 MIN_GAP_RATIO = 1.5  # an accepted effect must shrink the gap by at least this factor
+FAST_DT = 0.05  # default sample time of the model simulations (20 Hz covers every band)
+
+
+def _white_noise_scaled(noise, factor: float) -> dict:
+    """White-noise standard deviations of ``noise`` multiplied by ``sqrt(factor)`` (``factor = dt_meas / dt_sim``):
+    a white sequence's one-sided spectral density is ``2 sigma^2 dt``, so this keeps the density unchanged."""
+    g = math.sqrt(factor)
+    return {"acceleration_white": noise.acceleration_white * g, "moment_white": noise.moment_white * g,
+            "platform_white": noise.platform_white * g, "other_white": noise.other_white * g}
 
 
 def _bands(case: LoadCase) -> dict[str, tuple[float, float]]:
@@ -298,7 +307,8 @@ def run(
     channels : sequence of str
         Channels of the band-power features.
     sim_dt : float, optional
-        Sample time of the model simulations (default: the measured record's).
+        Sample time of the model simulations (default: the measured record's, but at least 0.05 s; when coarser,
+        the model's white sensor noise is scaled so its spectral density matches the measurement's).
     n_scatter : int
         Realisations of the candidate model used to estimate the seed-to-seed scatter (>= n_seeds).
 
@@ -323,15 +333,21 @@ def run(
     if int(n_seeds) < 3:
         raise ValueError(f"n_seeds must be at least 3 (the scatter needs them), got {n_seeds}")
     meas = features(measured, case, channels)
-    dt = measured.dt if sim_dt is None else float(sim_dt)
+    dt = max(measured.dt, FAST_DT) if sim_dt is None else float(sim_dt)
+    if dt > measured.dt * (1 + 1e-9):
+        # simulate coarser than measured: keep the white-noise floor's spectral density that of the measurement
+        # (density = 2 sigma^2 dt), so noise-dominated bands compare like with like
+        model_sim = model.with_noise(**_white_noise_scaled(model.noise, measured.dt / dt))
+    else:
+        model_sim = model
     seeds = [(1000 if seed is None else int(seed)) + i for i in range(int(n_seeds))]
     ev = _Evaluator(case, measured.duration + dt, dt, seeds, channels)
 
-    base_fm = ev.feature_matrix(model)
+    base_fm = ev.feature_matrix(model_sim)
     # the scatter needs more realisations than the mean: extra seeds for the candidate model only
     extra_seeds = list(range(seeds[-1] + 1, seeds[-1] + 1 + max(0, int(n_scatter) - len(seeds))))
     extra = _Evaluator(case, ev.duration, dt, extra_seeds, channels)
-    scatter_fm = np.vstack([base_fm, extra.feature_matrix(model)]) if extra.seeds else base_fm
+    scatter_fm = np.vstack([base_fm, extra.feature_matrix(model_sim)]) if extra.seeds else base_fm
     scatter = _scatter(scatter_fm, meas.kinds, base_fm.mean(axis=0))
     n_f = len(meas.names)
 
@@ -353,7 +369,7 @@ def run(
     # shows gaps of a few times the null level; only a gap clearly above it calls for a missing effect.
     threshold = max(3.0, 3.0 * null_gap)
 
-    current = model
+    current = model_sim
     current_fm = base_fm
     gap0 = gap(base_fm)
     z0 = zscores(base_fm)
@@ -400,6 +416,9 @@ def run(
         for i, (n, z) in enumerate(zip(meas.names, z0, strict=True)) if abs(z) > 3.0
     ]
     findings.sort(key=lambda d: -abs(d["z"]))
+    updated = model
+    for name, strength in named:
+        updated = updated.with_effects(**{name: strength})
     report = DiscrepancyReport(
         effect=named[0][0] if named else None,
         strength=named[0][1] if named else None,
@@ -412,10 +431,10 @@ def run(
         z_after=z1,
         findings=findings,
         candidates=log,
-        updated_model=current,
+        updated_model=updated,
         case=case,
     )
-    report._spectra = _spectra(measured, model, current, case, dt, seeds[0])
+    report._spectra = _spectra(measured, model_sim, current, case, dt, seeds[0])
     return report
 
 
@@ -439,8 +458,9 @@ def _spectra(measured: Record, before: FOWTModel, after: FOWTModel, case: LoadCa
     for label, m in runs.items():
         rec = surrogates.simulate(m, case, duration=measured.duration + dt, dt=dt, seed=seed)
         for ch in ("TwHt9ALxt", "PtfmPitch"):
-            out[(label, ch)] = welch(rec[ch] - rec[ch].mean(), fs=rec.fs, nperseg=min(rec.n_samples, 8192))
+            out[(label, ch)] = welch(rec[ch] - rec[ch].mean(), fs=rec.fs, nperseg=min(rec.n_samples, int(150 * rec.fs)))
     for ch in ("TwHt9ALxt", "PtfmPitch"):
         x = measured[ch]
-        out[("measured", ch)] = welch(x - np.nanmean(x), fs=measured.fs, nperseg=min(measured.n_samples, 8192))
+        out[("measured", ch)] = welch(x - np.nanmean(x), fs=measured.fs,
+                                      nperseg=min(measured.n_samples, int(150 * measured.fs)))
     return out
