@@ -124,7 +124,7 @@ def test_rotor_averaging_is_a_decreasing_reduction_and_converges():
     assert np.all(np.diff(h2) < 0) and np.all(np.diff(g) < 0)
     assert np.all(h2 >= g**2 - 1e-12)  # the 2x2 spectral matrix [[1, g], [g, h2]] is positive semi-definite
     assert h2[-1] < 0.002  # small eddies average out over the disc
-    fine_h2, fine_g = rotor_averaging(f[2:4], 12.0, n_rings=24, n_az=48)
+    fine_h2, fine_g = rotor_averaging(f[2:4], 12.0, n_points=2048)
     np.testing.assert_allclose(h2[2:4], fine_h2, rtol=0.03)
     np.testing.assert_allclose(g[2:4], fine_g, rtol=0.03)
 
