@@ -1,0 +1,289 @@
+"""Input checks shared by the estimators: clear ``ValueError`` messages that name the argument.
+
+Every public estimator validates its arguments here, so that bad input fails early with a message saying which
+argument, which channels and which samples are wrong — never with a deep ``LinAlgError`` or a silent NaN.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from numbers import Integral, Real
+
+import numpy as np
+
+__all__ = [
+    "NotFittedError",
+    "as_2d_float",
+    "as_records",
+    "check_fitted",
+    "check_int",
+    "check_no_constant_channels",
+    "check_number",
+    "constant_channels",
+    "describe_nonfinite",
+    "is_record_list",
+]
+
+_MAX_LISTED = 5
+
+
+class NotFittedError(ValueError, AttributeError):
+    """An estimator was used before :meth:`fit` (a ``ValueError`` and an ``AttributeError``, as in scikit-learn)."""
+
+
+def _list_indices(idx: np.ndarray, limit: int = _MAX_LISTED) -> str:
+    idx = np.asarray(idx).ravel()
+    shown = ", ".join(str(int(i)) for i in idx[:limit])
+    return f"[{shown}, ...] ({idx.size} in all)" if idx.size > limit else f"[{shown}]"
+
+
+def describe_nonfinite(Y: np.ndarray, *, include_nan: bool = True) -> str:
+    """Say which channels and (first few) samples of a 2-D array hold NaN or ±inf.
+
+    Parameters
+    ----------
+    Y : ndarray (n_samples, n_channels)
+    include_nan : bool
+        Report NaN too (otherwise only ±inf).
+
+    Returns
+    -------
+    str
+        Empty if all checked values are fine, else e.g. ``"channel 3: NaN at samples [10, 11] ..."``.
+    """
+    bad = np.isinf(Y) | (np.isnan(Y) if include_nan else False)
+    if not bad.any():
+        return ""
+    channels = np.flatnonzero(bad.any(axis=0))
+    parts = []
+    for c in channels[:_MAX_LISTED]:
+        rows = np.flatnonzero(bad[:, c])
+        kinds = sorted({"NaN" if np.isnan(v) else "inf" for v in Y[rows[:_MAX_LISTED], c]})
+        parts.append(f"channel {int(c)}: {'/'.join(kinds)} at samples {_list_indices(rows)}")
+    more = f"; and {channels.size - _MAX_LISTED} more channels" if channels.size > _MAX_LISTED else ""
+    return "; ".join(parts) + more
+
+
+def as_2d_float(
+    Y: object,
+    name: str = "Y",
+    *,
+    allow_nan: bool = False,
+    min_samples: int = 1,
+    n_channels: int | None = None,
+) -> np.ndarray:
+    """Return ``Y`` as a C-contiguous float64 array of shape ``(n_samples, n_channels)`` after checking it.
+
+    Parameters
+    ----------
+    Y : array_like (n_samples, n_channels)
+        Time-major data.
+    name : str
+        Argument name used in error messages.
+    allow_nan : bool
+        Let NaN through (missing data); ±inf is always an error.
+    min_samples : int
+        Minimum number of rows.
+    n_channels : int, optional
+        Required number of columns (e.g. the number seen in ``fit``).
+
+    Returns
+    -------
+    ndarray (n_samples, n_channels) of float64
+
+    Raises
+    ------
+    ValueError
+        Not numeric (or complex), not 2-D, too few samples, wrong channel count, or non-finite values; the
+        message lists the offending channels and the first few sample indices.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> as_2d_float([[1, 2], [3, 4]]).dtype
+    dtype('float64')
+    >>> as_2d_float(np.array([[1.0, np.nan], [2.0, 3.0]]), "Y_train")
+    Traceback (most recent call last):
+    ...
+    ValueError: Y_train must be finite: channel 1: NaN at samples [0]
+    """
+    if is_record_list(Y):
+        raise ValueError(f"{name} must be one 2-D array here, got a list of {len(Y)} records")
+    try:
+        arr = np.asarray(Y)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be a numeric array, got {type(Y).__name__}: {exc}") from exc
+    if arr.dtype == object or not (np.issubdtype(arr.dtype, np.number) or arr.dtype == bool):
+        raise ValueError(f"{name} must be a numeric array, got dtype {arr.dtype}")
+    if np.iscomplexobj(arr):
+        raise ValueError(f"{name} must be real, got complex dtype {arr.dtype}")
+    if arr.ndim != 2:
+        hint = " (use Y[:, None] for a single channel)" if arr.ndim == 1 else ""
+        raise ValueError(f"{name} must be 2-D (n_samples, n_channels), got shape {arr.shape}{hint}")
+    if arr.shape[1] < 1:
+        raise ValueError(f"{name} must have at least one channel, got shape {arr.shape}")
+    if n_channels is not None and arr.shape[1] != n_channels:
+        raise ValueError(f"{name} must have {n_channels} channels (as in fit), got {arr.shape[1]}")
+    if arr.shape[0] < min_samples:
+        raise ValueError(f"{name} must have at least {min_samples} samples, got {arr.shape[0]}")
+    arr = np.ascontiguousarray(arr, dtype=np.float64)
+    if not np.isfinite(arr).all():
+        msg = describe_nonfinite(arr, include_nan=not allow_nan)
+        if msg:
+            what = "finite (no ±inf)" if allow_nan else "finite"
+            raise ValueError(f"{name} must be {what}: {msg}")
+    return arr
+
+
+def is_record_list(Y: object) -> bool:
+    """True if ``Y`` is a list/tuple of 2-D records rather than one array (a nested list of rows is one array)."""
+    return (
+        isinstance(Y, Sequence)
+        and not isinstance(Y, (str, bytes, np.ndarray))
+        and len(Y) > 0
+        and all(np.ndim(y) == 2 for y in Y)
+    )
+
+
+def as_records(
+    Y: object,
+    name: str = "Y",
+    *,
+    allow_nan: bool = False,
+    min_samples: int = 1,
+    n_channels: int | None = None,
+) -> list[np.ndarray]:
+    """One 2-D array or a list of them (separate records) -> list of checked float64 arrays.
+
+    All records must have the same number of channels. Errors name the record: ``"Y[2] must be finite: ..."``.
+
+    Parameters
+    ----------
+    Y : array_like (n_samples, n_channels) or sequence of them
+    name, allow_nan, min_samples, n_channels
+        As in :func:`as_2d_float`.
+
+    Returns
+    -------
+    list of ndarray
+    """
+    if isinstance(Y, (list, tuple)) and len(Y) == 0:
+        raise ValueError(f"{name} must be a 2-D array or a non-empty list of records, got an empty list")
+    if not is_record_list(Y):
+        return [as_2d_float(Y, name, allow_nan=allow_nan, min_samples=min_samples, n_channels=n_channels)]
+    records = []
+    for i, y in enumerate(Y):
+        rec = as_2d_float(y, f"{name}[{i}]", allow_nan=allow_nan, min_samples=min_samples, n_channels=n_channels)
+        n_channels = rec.shape[1]
+        records.append(rec)
+    return records
+
+
+def constant_channels(Y: np.ndarray, *, rtol: float = 1e-12) -> np.ndarray:
+    """Indices of channels whose finite values do not vary (peak-to-peak <= ``rtol`` x their magnitude).
+
+    NaN samples are ignored; an all-NaN channel counts as constant.
+
+    Parameters
+    ----------
+    Y : ndarray (n_samples, n_channels)
+    rtol : float
+        Relative tolerance on the peak-to-peak range.
+
+    Returns
+    -------
+    ndarray of int
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> constant_channels(np.array([[1.0, 2.0, 0.0], [1.0, 3.0, 0.0]]))
+    array([0, 2])
+    """
+    Y = np.asarray(Y, dtype=float)
+    finite = np.isfinite(Y)
+    hi = np.where(finite, Y, -np.inf).max(axis=0)
+    lo = np.where(finite, Y, np.inf).min(axis=0)
+    none = ~finite.any(axis=0)
+    with np.errstate(invalid="ignore"):
+        scale = np.maximum(np.abs(hi), np.abs(lo))
+        const = none | ((hi - lo) <= rtol * scale)
+    return np.flatnonzero(const)
+
+
+def check_no_constant_channels(Y: np.ndarray, name: str = "Y", *, rtol: float = 1e-12) -> None:
+    """Raise a ``ValueError`` naming the constant channels of ``Y`` (see :func:`constant_channels`)."""
+    const = constant_channels(Y, rtol=rtol)
+    if const.size:
+        raise ValueError(
+            f"{name} has constant channel(s) {_list_indices(const)}: they carry no dynamics and make the "
+            "problem singular (a dead or saturated sensor?); remove them before fitting"
+        )
+
+
+def check_number(
+    name: str,
+    value: object,
+    *,
+    positive: bool = False,
+    nonneg: bool = False,
+    low: float | None = None,
+    high: float | None = None,
+) -> float:
+    """Return ``value`` as a float after checking it is a finite real number, optionally in a range.
+
+    Parameters
+    ----------
+    name : str
+        Argument name used in the error message.
+    value : float
+    positive, nonneg : bool
+        Require ``> 0`` or ``>= 0``.
+    low, high : float, optional
+        Require ``low < value < high`` (open interval).
+
+    Raises
+    ------
+    ValueError
+    """
+    if isinstance(value, (bool, str, bytes)) or (not isinstance(value, Real) and np.ndim(value) != 0):
+        raise ValueError(f"{name} must be a real number, got {value!r}")
+    try:
+        v = float(value)  # also numpy scalars and 0-d arrays
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be a real number, got {value!r}") from exc
+    if not np.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    if positive and v <= 0:
+        raise ValueError(f"{name} must be > 0, got {value!r}")
+    if nonneg and v < 0:
+        raise ValueError(f"{name} must be >= 0, got {value!r}")
+    if low is not None and not v > low:
+        raise ValueError(f"{name} must be > {low}, got {value!r}")
+    if high is not None and not v < high:
+        raise ValueError(f"{name} must be < {high}, got {value!r}")
+    return v
+
+
+def check_int(name: str, value: object, *, minimum: int | None = None, maximum: int | None = None) -> int:
+    """Return ``value`` as an int after checking it is an integer (not bool, not float) within bounds.
+
+    Raises
+    ------
+    ValueError
+    """
+    if isinstance(value, bool) or not isinstance(value, Integral):
+        raise ValueError(f"{name} must be an integer, got {value!r}")
+    v = int(value)
+    if minimum is not None and v < minimum:
+        raise ValueError(f"{name} must be >= {minimum}, got {v}")
+    if maximum is not None and v > maximum:
+        raise ValueError(f"{name} must be <= {maximum}, got {v}")
+    return v
+
+
+def check_fitted(estimator: object, attributes: str | Sequence[str]) -> None:
+    """Raise :class:`NotFittedError` if ``estimator`` lacks any of the fitted ``attributes``."""
+    attrs = [attributes] if isinstance(attributes, str) else list(attributes)
+    if not all(hasattr(estimator, a) for a in attrs):
+        raise NotFittedError(f"this {type(estimator).__name__} is not fitted yet: call fit() first")
