@@ -9,6 +9,7 @@ Examples
     fowt-env simulate --case 4 --effects none --no-noise --out linear.npz
     fowt-env modes --case 7 --json modes.json
     fowt-env episode --case 5 --plane FA --fault scenario:A --fault dropout:0.1:2 --duration 120 --out ep.npz
+    fowt-env identify olc7.npz --plane FA --json modes.json --plot figs
     fowt-env discrepancy measured.npz --case 7 --model-effects aero_damping=0 --json report.json --plot figs
 """
 
@@ -166,6 +167,56 @@ def _cmd_discrepancy(args: argparse.Namespace) -> int:
     return 0
 
 
+def _load_record(path: str):
+    import surrogates
+
+    p = Path(path)
+    if not p.exists():
+        raise SystemExit(f"fowt-env: no such file: {path}")
+    try:
+        return surrogates.Record.load(p)
+    except (OSError, KeyError, ValueError) as exc:
+        raise SystemExit(f"fowt-env: cannot read {path} as a record: {exc}") from exc
+
+
+def _identification_reference(rec, case_arg: str | None, plane: str | None, effects: str):
+    """Linear reference for ``identify``: from --case, else from the record's own load case if it has one."""
+    import surrogates
+
+    from .identification import model_reference
+
+    if case_arg is not None:
+        case = _case(case_arg)
+    elif isinstance(rec.meta.get("case"), dict):
+        case = surrogates.LoadCase.from_dict(rec.meta["case"])
+    else:
+        return None
+    return model_reference(surrogates.FOWTModel(_parse_effects(effects)), case, plane=plane)
+
+
+def _cmd_identify(args: argparse.Namespace) -> int:
+    from .identification import identify
+
+    rec = _load_record(args.record)
+    channels = args.channels.split(",") if args.channels else None
+    ref = None if args.no_reference else _identification_reference(rec, args.case, args.plane, args.effects)
+    rank: int | float | str = args.rank if args.rank == "auto" else (float(args.rank) if "." in args.rank
+                                                                         else int(args.rank))
+    delays: int | float = float(args.delays) if "." in args.delays else int(args.delays)
+    t0 = time.perf_counter()
+    res = identify(rec, channels=channels, plane=args.plane, delays=delays, rank=rank, ssi=not args.no_ssi,
+                   reference=ref)
+    print(res.summary())
+    print(f"({time.perf_counter() - t0:.1f} s)")
+    if args.json:
+        Path(args.json).write_text(json.dumps(res.to_dict(), indent=2))
+        print(f"wrote {args.json}")
+    if args.plot:
+        for path in res.plot(args.plot):
+            print(f"wrote {path}")
+    return 0
+
+
 def _stats_table(rec, names: list[str]) -> str:
     rows = [f"{'channel':<12}{'unit':>8}{'mean':>12}{'std':>12}{'min':>12}{'max':>12}"]
     for n in names:
@@ -173,6 +224,20 @@ def _stats_table(rec, names: list[str]) -> str:
         u = rec.units[rec.channels.index(n)]
         rows.append(f"{n:<12}{u:>8}{np.mean(v):>12.4g}{np.std(v):>12.4g}{np.min(v):>12.4g}{np.max(v):>12.4g}")
     return "\n".join(rows)
+
+
+def _demo_identification(rec, model, case, folder: Path) -> None:
+    """Output-only identification of the demo record, side by side with the model's own linearisation."""
+    from .identification import identify, model_reference
+
+    print("\nIdentification from the 18 fore-aft tower channels alone (Hankel-DMD, 2.5 s of delays, rank 24; "
+          "SSI-COV), against the linearised model at this load case:")
+    ref = model_reference(model, case, plane="FA")
+    t0 = time.perf_counter()
+    res = identify(rec, plane="FA", reference=ref)
+    print(res.summary())
+    paths = res.plot(folder)
+    print(f"wrote {len(paths)} figures to {folder} ({time.perf_counter() - t0:.1f} s)")
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
@@ -201,6 +266,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
                      modes=list(zip(modes.labels, modes.frequencies_hz, strict=True)), rotor_rpm=case.rotor_rpm,
                      title=f"Tower-top acceleration, {case.name} (modes: parked linear model)")
     print(f"\nwrote {path}\nwrote {fig}")
+    _demo_identification(rec, model, case, out / "identification")
     if args.skip_discrepancy or rec.duration < 300.0:
         if not args.skip_discrepancy:
             print("(discrepancy round trip skipped: it needs a record of at least 300 s)")
@@ -263,6 +329,22 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--json", default=None, help="write the report as JSON")
     q.add_argument("--plot", default=None, help="folder for the figure")
     q.set_defaults(func=_cmd_discrepancy)
+
+    i = sub.add_parser("identify", help="identify modes of a record with Hankel-DMD and SSI-COV (Table-3 style)")
+    i.add_argument("record", help="record file (.npz written by fowt-env or surrogates.Record.save)")
+    i.add_argument("--plane", choices=["FA", "SS"], default=None,
+                   help="use the 18 channels of one plane (default: all tower channels)")
+    i.add_argument("--channels", default=None, help="comma-separated channels (overrides --plane)")
+    i.add_argument("--delays", default="2.5", help="Hankel delay: seconds (e.g. 2.5, default) or samples (60)")
+    i.add_argument("--rank", default="24", help="DMD rank: int, energy fraction (0.99) or 'auto'")
+    i.add_argument("--case", default=None,
+                   help="OLC of the linear reference (default: the record's own case, if it has one)")
+    i.add_argument("--effects", default="all", help="effects of the reference model")
+    i.add_argument("--no-reference", action="store_true", help="do not compare with the linearised model")
+    i.add_argument("--no-ssi", action="store_true", help="skip SSI-COV")
+    i.add_argument("--json", default=None, help="write modes and pairing as JSON")
+    i.add_argument("--plot", default=None, help="folder for the figures")
+    i.set_defaults(func=_cmd_identify)
 
     m = sub.add_parser("modes", help="modal frequencies and damping of the linearised model")
     m.add_argument("--case", default=None, help="OLC number (default: parked, still water)")

@@ -7,7 +7,38 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import welch
 
-__all__ = ["psd_figure"]
+__all__ = [
+    "eigenvalue_figure",
+    "psd_figure",
+    "singular_value_figure",
+    "spectrogram_figure",
+    "stabilization_figure",
+]
+
+
+_KIND_STYLE = {"structural": ("tab:blue", "o"), "harmonic": ("tab:red", "D"), "noise": ("0.6", ".")}
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _prepare(path: str | Path) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def _save(fig, path: Path) -> Path:
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    _pyplot().close(fig)
+    return path
 
 
 def psd_figure(
@@ -43,13 +74,8 @@ def psd_figure(
     Path
         The written file.
     """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    plt = _pyplot()
+    path = _prepare(path)
     fs = record.fs
     nperseg = int(min(len(record), 2 ** int(np.log2(max(fs * 120.0, 256)))))
     fig, axes = plt.subplots(len(channels), 1, figsize=(9, 3.0 * len(channels)), sharex=True, squeeze=False)
@@ -76,7 +102,188 @@ def psd_figure(
     axes[-1, 0].set_xlim(0.0, f_max)
     if title:
         fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
+
+
+def eigenvalue_figure(dmd, mode_table: list[dict], path: str | Path) -> Path:
+    """DMD eigenvalues on the unit circle (left) and frequency vs damping (right), coloured by mode kind.
+
+    Parameters
+    ----------
+    dmd : estimators.HankelDMD
+        A fitted model.
+    mode_table : list of dict
+        Its :meth:`~estimators.HankelDMD.mode_table` (gives each eigenvalue's kind).
+    path : str or Path
+        Output PNG file.
+
+    Returns
+    -------
+    Path
+    """
+    plt = _pyplot()
+    path = _prepare(path)
+    kind = np.full(dmd.eigenvalues_.size, "noise", dtype=object)
+    for row in mode_table:
+        i = row["index"]
+        conj = np.argmin(np.abs(dmd.eigenvalues_ - np.conj(dmd.eigenvalues_[i])))
+        kind[[i, conj]] = row["kind"]
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 5))
+    th = np.linspace(0, 2 * np.pi, 400)
+    ax.plot(np.cos(th), np.sin(th), color="0.3", lw=0.8)
+    for k, (color, marker) in _KIND_STYLE.items():
+        sel = kind == k
+        mu = dmd.eigenvalues_[sel]
+        ax.scatter(mu.real, mu.imag, s=22, color=color, marker=marker, label=f"{k} ({sel.sum()})")
+        f = np.abs(dmd.frequencies_hz_[sel])
+        bx.scatter(f, 100 * dmd.damping_ratios_[sel], s=22, color=color, marker=marker, label=k)
+    ax.set_aspect("equal")
+    ax.set_xlabel("Re(mu)")
+    ax.set_ylabel("Im(mu)")
+    ax.set_title(f"Discrete DMD eigenvalues (rank {dmd.rank_}, d = {dmd.delays_})")
+    ax.legend(loc="lower left", fontsize=8)
+    ax.grid(alpha=0.3)
+    bx.set_xlabel("frequency (Hz)")
+    bx.set_ylabel("damping ratio (%)")
+    bx.set_title("Modes: frequency and damping")
+    bx.set_ylim(-2, 25)
+    bx.grid(alpha=0.3)
+    return _save(fig, path)
+
+
+def singular_value_figure(dmd, path: str | Path) -> Path:
+    """Singular values of the Hankel matrix with the rank kept and the Gavish-Donoho threshold.
+
+    Parameters
+    ----------
+    dmd : estimators.HankelDMD
+        A fitted model.
+    path : str or Path
+        Output PNG file.
+
+    Returns
+    -------
+    Path
+    """
+    from estimators.hankel_dmd import svht_rank
+
+    plt = _pyplot()
+    path = _prepare(path)
+    s = np.asarray(dmd.singular_values_)
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    k = np.arange(1, s.size + 1)
+    ax.semilogy(k, s / s[0], ".", ms=3, color="C0", label="singular values (normalised)")
+    ax.axvline(dmd.rank_, color="tab:red", lw=1.2, label=f"rank used: {dmd.rank_}")
+    if dmd.method_ != "randomized":
+        shape = (dmd.delays_ * dmd.n_features_in_, dmd.n_snapshots_)
+        r_gd = svht_rank(s, shape)
+        ax.axvline(r_gd, color="tab:green", ls="--", lw=1.0, label=f"Gavish-Donoho threshold: {r_gd}")
+    ax.set_xlabel("index")
+    ax.set_ylabel("sigma_k / sigma_1")
+    ax.set_title("Singular-value spectrum of the Hankel matrix")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    return _save(fig, path)
+
+
+def spectrogram_figure(x: np.ndarray, dt: float, name: str, unit: str, path: str | Path,
+                       f_max: float = 3.0) -> Path:
+    """Spectrogram (dB) of one channel: how the spectrum moves with time (rotor speed, sea state).
+
+    Parameters
+    ----------
+    x : ndarray (n_samples,)
+        Signal (channel units).
+    dt : float
+        Sample interval (s).
+    name, unit : str
+        Channel name and unit (labels).
+    path : str or Path
+        Output PNG file.
+    f_max : float
+        Upper frequency (Hz).
+
+    Returns
+    -------
+    Path
+    """
+    from scipy.signal import spectrogram
+
+    plt = _pyplot()
+    path = _prepare(path)
+    fs = 1.0 / dt
+    nper = int(min(len(x), 2 ** int(np.log2(max(fs * 40.0, 64)))))
+    f, t, S = spectrogram(x - np.mean(x), fs=fs, nperseg=nper, noverlap=nper * 3 // 4)
+    sel = f <= f_max
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    im = ax.pcolormesh(t, f[sel], 10 * np.log10(S[sel] + 1e-300), shading="auto", cmap="viridis")
+    fig.colorbar(im, ax=ax, label=f"PSD (dB re 1 ({unit})²/Hz)")
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("frequency (Hz)")
+    ax.set_title(f"Spectrogram of {name}")
+    return _save(fig, path)
+
+
+def stabilization_figure(ssi, Y: np.ndarray, dt: float, path: str | Path, reference=None,
+                         f_max: float | None = None) -> Path:
+    """SSI-COV stabilisation diagram over the averaged PSD of the channels, with the selected modes marked.
+
+    Parameters
+    ----------
+    ssi : estimators.SSICov
+        A fitted model.
+    Y : ndarray (n_samples, n_channels)
+        The data it was fitted on (any scaling; each channel's PSD is normalised before averaging).
+    dt : float
+        Sample interval of ``Y`` (s).
+    path : str or Path
+        Output PNG file.
+    reference : fowt_env.identification.LinearReference, optional
+        Linear-model frequencies to mark (dashed grey, labelled).
+    f_max : float, optional
+        Upper frequency (Hz); default the highest pole shown, capped at Nyquist.
+
+    Returns
+    -------
+    Path
+    """
+    plt = _pyplot()
+    path = _prepare(path)
+    rows = ssi.stabilization_
+    if f_max is None:
+        top = max((float(np.max(r["frequencies_hz"])) for r in rows if len(r["frequencies_hz"])), default=1.0)
+        f_max = min(1.05 * top, 0.5 / dt)
+    fig, ax = plt.subplots(figsize=(10, 5.5))
+    first = {True: True, False: True}
+    for r in rows:
+        f = np.asarray(r["frequencies_hz"])
+        st = np.asarray(r["stable"], dtype=bool)
+        for flag, style in ((False, dict(marker="x", color="0.7", s=10)), (True, dict(marker="o", color="k", s=9))):
+            sel = (st == flag) & (f <= f_max)
+            if sel.any():
+                lab = ("stable pole" if flag else "unstable pole") if first[flag] else None
+                first[flag] = False
+                ax.scatter(f[sel], np.full(sel.sum(), r["order"]), label=lab, **style)
+    for k, fk in enumerate(ssi.frequencies_hz_):
+        ax.axvline(fk, color="tab:blue", lw=1.0, alpha=0.6, label="selected mode" if k == 0 else None)
+    if reference is not None:
+        for lab, fk in zip(reference.labels, reference.frequencies_hz, strict=True):
+            if fk <= f_max:
+                ax.axvline(fk, color="0.4", ls="--", lw=0.8)
+                ax.text(fk, 1.0, f" {lab}", rotation=90, va="top", ha="left", fontsize=7, color="0.3",
+                        transform=ax.get_xaxis_transform())
+    ax.set_xlabel("frequency (Hz)")
+    ax.set_ylabel("model order")
+    ax.set_xlim(0.0, f_max)
+    ax.set_title("SSI-COV stabilisation diagram")
+    bx = ax.twinx()
+    nper = int(min(len(Y), 2 ** int(np.log2(max(40.0 / dt, 256)))))
+    f, P = welch(Y - Y.mean(axis=0), fs=1.0 / dt, nperseg=nper, axis=0)
+    P = np.mean(P / np.maximum(P.max(axis=0, keepdims=True), 1e-300), axis=1)
+    sel = f <= f_max
+    bx.semilogy(f[sel], P[sel], color="tab:orange", lw=0.9, alpha=0.8, label="mean normalised PSD")
+    bx.set_ylabel("mean normalised PSD (-)")
+    h1, l1 = ax.get_legend_handles_labels()
+    h2, l2 = bx.get_legend_handles_labels()
+    ax.legend(h1 + h2, l1 + l2, loc="upper right", fontsize=8)
+    return _save(fig, path)
