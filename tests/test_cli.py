@@ -56,3 +56,10 @@ def test_example_env_random_dropouts(tmp_path, monkeypatch):
     runpy.run_path(str(__import__("pathlib").Path(__file__).parents[1] / "examples" / "env_random_dropouts.py"),
                    run_name="__main__")
     assert (tmp_path / "fig.png").exists()
+
+
+def test_example_identify_vs_linearization(tmp_path, monkeypatch):
+    monkeypatch.setattr(sys, "argv", ["identify_vs_linearization.py", "--duration", "240", "--out", str(tmp_path)])
+    runpy.run_path(str(__import__("pathlib").Path(__file__).parents[1] / "examples" / "identify_vs_linearization.py"),
+                   run_name="__main__")
+    assert len(list((tmp_path / "identification_FA").glob("*.png"))) == 4
