@@ -5,12 +5,27 @@ The sensor estimates every output channel of a continuous-time linear model ``x'
 from whichever channels are alive, following the virtual-sensor protocol of :mod:`estimators.baseline`.
 
 The unknown loads (wave excitation, wind) are not measured, so they join the state (augmented Kalman filter,
-Lourens et al. 2012, *Mech. Syst. Signal Process.* 27, 446-460) with a first-order Gauss-Markov (AR(1)) or a
-random-walk model. The augmented continuous model is discretised exactly (matrix exponential; zero-order hold
-on the known inputs; Van Loan's method for the process-noise covariance). :meth:`KalmanSensor.fit` learns
-everything that would otherwise be hand-tuned -- channel means, measurement noise from the high-frequency noise
-floor, the relative load levels by moment matching, and the overall process-noise level by maximising the
-innovation log-likelihood of the training data.
+Lourens et al. 2012, *Mech. Syst. Signal Process.* 27, 446-460) as a first-order Gauss-Markov (AR(1)) or
+random-walk process. The model is discretised exactly with the matrix exponential (zero-order hold of the loads
+and of the known inputs over a sample). :meth:`KalmanSensor.fit` learns what would otherwise be hand-tuned:
+
+1. channel means and scales (the filter runs on z-scored channels, states scaled to unit variance);
+2. the white measurement noise of each channel, from its high-frequency noise floor;
+3. the load model: nominal levels that let each load alone explain the channel variances, one overall level
+   (and optionally the load time constant) by maximising the innovation log-likelihood of the training data
+   over a grid, then the full load covariance (levels *and* correlations, e.g. the coherent surge force and
+   pitch moment of the same waves) by expectation-maximisation (Shumway & Stoffer 1982), each step of which
+   increases that likelihood.
+
+The likelihood that the search and EM climb is an exact one (see :meth:`KalmanSensor.fit`): the complete stretches
+of the training data are cut into pieces of at most ``_MAX_PIECE`` samples, each piece starts from what the
+steady-state filter of the starting model knows at that point, and the exact time-varying Kalman filter and
+Rauch-Tung-Striebel smoother run on the pieces, so that the EM statistics and the likelihood come from one and the
+same model. (The steady-state filter alone is exact only for the model it was computed for, and the time-varying
+one converges far too slowly here to be run over whole records: the lightly damped, barely observable platform
+modes keep its gain changing for minutes.) The covariance recursion does not depend on the data, so it runs once
+per piece length, shared by all pieces, and stops once converged; the means of the pieces are propagated together,
+so a fit on ten minutes of 80 Hz data takes seconds.
 """
 
 from __future__ import annotations
@@ -20,60 +35,72 @@ from collections.abc import Sequence
 
 import numpy as np
 import scipy.linalg as sla
-from scipy.optimize import nnls
+from scipy.linalg.lapack import dpotrf as _dpotrf
+from scipy.linalg.lapack import dtrtri as _dtrtri
 from scipy.signal import lfilter
 
 __all__ = ["KalmanSensor"]
 
-_DIFF_ORDER = 4  # order of the differences used to measure the white-noise floor
+_DIFF_ORDER = 4  # order of the differences that measure the white-noise floor
 _DIFF_GAIN = math.comb(2 * _DIFF_ORDER, _DIFF_ORDER)  # var(diff^k e) / var(e) for white e
-_MIN_NOISE_REL = 1e-3  # measurement noise std >= this fraction of the channel's std (keeps S well conditioned)
-_MIN_FORCE_REL = 1e-3  # nominal load std >= this fraction of the largest one, relative to its effect
+_MIN_NOISE_REL = 1e-3  # measurement-noise std >= this fraction of the channel's std (keeps S well conditioned)
+_MAX_PIECE = 2048  # training data are cut into pieces of at most this many samples for the exact filter
+_SMOOTHER_BYTES = 32_000_000  # memory for the smoother's stored covariances (caps the pieces of large models)
+_MIN_SEGMENT = 200  # shortest complete training stretch used by the search (samples)
+_STEADY_TOL = 1e-14  # filter/smoother covariances whose step changes them less than this (relative) have converged
+_LEAD_S = 10.0  # time at the start of a training segment that only conditions its first piece (s)
 
 
 class KalmanSensor:
     """Virtual sensor: augmented Kalman filter on a linear model, with dropouts, gating and learned noise.
 
-    State ``z = [x, f]``: the model's states ``x`` and its unknown inputs ``f`` (loads), which follow
+    State ``z = [x, f]``: the model's states ``x`` and its unknown inputs ``f`` (loads), with
 
-    * ``"ar1"`` (default): ``f' = -f / tau + w``, a first-order Gauss-Markov process with time constant ``tau``;
-    * ``"random_walk"``: ``f' = w``.
+    * ``"ar1"`` (default): ``f[k+1] = phi f[k] + w[k]``, ``phi = exp(-dt / tau)`` (first-order Gauss-Markov);
+    * ``"random_walk"``: ``f[k+1] = f[k] + w[k]``;
 
-    The measured channels are ``y = C x + D_f f + D_k u_k + mean + v`` (accelerations have feedthrough of the
-    loads), with ``u_k`` the known inputs (zero unless given to :meth:`update`) and ``v`` white measurement
-    noise. Internally the outputs are z-scored with the training statistics and the states are scaled by their
-    stationary standard deviations, so that the covariances are well conditioned although the loads are
-    ~1e5-1e7 N and the outputs mix m/s² and kN·m.
+    ``w`` white with covariance ``Q_f`` (learned), and ``x`` driven by ``f`` held over each sample. The channels
+    are ``y = C x + D_f f + D_k u + mean + v`` (accelerations have feedthrough of the loads), with ``u`` the
+    known inputs (zero unless given to :meth:`update`) and ``v`` white measurement noise. Internally the
+    channels are z-scored with the training statistics and the states scaled by their stationary standard
+    deviations, so that the covariances stay well conditioned although the loads are ~1e5-1e7 N and the
+    channels mix m/s² and kN·m.
 
     Parameters
     ----------
     system : control.StateSpace or tuple (A, B, C, D)
-        Continuous-time model (SI units; outputs in the units of the recorded channels, as deviations from the
-        operating-point mean). Its outputs are the channels the sensor receives and returns, in that order.
+        Continuous-time, stable model in SI units, outputs in the units of the recorded channels, as deviations
+        from the operating-point mean. Its outputs are the channels the sensor receives and returns, in order.
     dt : float
         Sample time (s) of the data the sensor will see.
     unknown_inputs : sequence of str or int, optional
         Inputs that are unknown loads and become augmented states (names, or indices into the inputs). Default:
         every input whose name does not contain ``"offset"`` (for ``FOWTModel.linearize``: ``wave_Fx`` ...
-        ``wave_Mz`` and ``wind_dev``; ``pitch_offset`` and ``torque_offset`` are known control actions). For a
+        ``wave_Mz`` and ``wind_dev``; ``pitch_offset`` and ``torque_offset`` are known control actions); for a
         tuple system, every input.
     force_model : {"ar1", "random_walk"}
         Dynamics of the unknown loads.
     force_time_constant : float or sequence of float
-        Time constant ``tau`` of the AR(1) load model (s). A sequence is a grid: :meth:`fit` picks the value of
-        highest innovation likelihood. For ``"random_walk"`` it only sets the initial uncertainty and scaling.
+        Time constant ``tau`` of the AR(1) load model (s). A sequence is a grid: :meth:`fit` keeps the value of
+        highest innovation likelihood. For ``"random_walk"`` it only sets the initial covariance (the AR(1)
+        stationary one) and the scaling.
     process_noise : float, optional
-        Overall load level ``alpha`` relative to the moment-matched nominal levels (-). None (default): learned
-        by :meth:`fit` by maximising the innovation log-likelihood.
+        Fix the load level ``alpha`` (multiplier of the nominal load standard deviations, -) instead of
+        learning it; then neither the grid search nor EM runs. Default None: learned.
     measurement_noise : float or array_like (n_outputs,), optional
-        Measurement-noise standard deviation per channel (channel units). None (default): learned by
-        :meth:`fit` from the high-frequency noise floor of the training data.
+        White measurement-noise standard deviation per channel (channel units). Default None: learned from
+        the high-frequency noise floor of the training data.
     gate_sigma : float or None
-        Innovation gate: a live channel whose normalised innovation ``|e_i| / sqrt(S_ii)`` exceeds this is
-        ignored for that sample (counted in :attr:`n_gated_`). None or ``inf`` disables gating.
+        Innovation gate (standard deviations): a live channel whose leave-one-out residual (see Notes) exceeds
+        this is ignored for that sample (counted in :attr:`n_gated_`). None or ``inf`` disables gating.
+    em_iter : int
+        Maximum number of EM E-steps (likelihood evaluations, SQUAREM extrapolations included) for the load
+        covariance after the grid search (0: grid only).
+    em_tol : float
+        EM stops when the log-likelihood per sample rises by less than this.
     max_fit_samples : int
-        Longest stretch of training data (samples, summed over records) used for the likelihood search; the
-        means and noise floor use all of it.
+        Training samples (summed over records) used by the likelihood search and EM; the means and the noise
+        floor use all of them.
 
     Attributes
     ----------
@@ -81,49 +108,64 @@ class KalmanSensor:
         Number of channels (model outputs).
     channels_ : list of str
         Output names.
-    unknown_inputs_ : list of str
-        Names of the inputs estimated as augmented states.
-    known_inputs_ : list of str
-        Names of the inputs that :meth:`update` accepts as ``u``.
-    mean_ : ndarray (n_channels,)
-        Training mean per channel (channel units); added back to the estimate.
-    scale_ : ndarray (n_channels,)
-        Training standard deviation per channel (channel units); internal z-scoring.
+    unknown_inputs_, known_inputs_ : list of str
+        Inputs estimated as augmented states; inputs :meth:`update` accepts as ``u``.
+    mean_, scale_ : ndarray (n_channels,)
+        Training mean and standard deviation per channel (channel units).
     measurement_noise_std_ : ndarray (n_channels,)
-        Measurement-noise standard deviation per channel (channel units).
-    force_std_ : ndarray (n_unknown,)
-        Stationary standard deviation of each unknown load in the fitted model (input units, e.g. N, N·m, m/s).
+        White measurement-noise standard deviation per channel (channel units).
     force_time_constant_ : float
         Time constant of the load model (s).
     process_noise_ : float
-        Fitted (or given) overall load level ``alpha`` (-).
+        Overall load level chosen by the grid search (or given), relative to the nominal levels (-).
+    force_std_ : ndarray (n_unknown,)
+        Stationary standard deviation of each load in the fitted model (input units: N, N·m, m/s); for the
+        random walk, that of the AR(1) model with the same increments.
+    force_corr_ : ndarray (n_unknown, n_unknown)
+        Correlation matrix of the load increments ``w`` (from EM; identity before).
     log_likelihood_ : float
-        Innovation log-likelihood per sample of the training data at the fitted parameters.
+        Log-likelihood per sample of the training data at the fitted parameters (z-scored units), as defined in
+        :meth:`fit`.
     search_ : list of dict
-        Every ``(force_time_constant, process_noise, log_likelihood)`` evaluated by :meth:`fit`.
+        Every ``force_time_constant``, ``process_noise``, ``log_likelihood`` evaluated by the grid search.
+    em_log_likelihood_ : list of float
+        Log-likelihood per sample of each EM iterate: the starting point (the best grid point, the same value as
+        in :attr:`search_`), every EM step and every accepted SQUAREM extrapolation, in order; non-decreasing
+        (rejected extrapolations are not iterates and are not listed). Empty without EM.
     n_gated_ : int
         Channel samples rejected by the innovation gate since :meth:`reset`.
     gated_counts_ : ndarray of int (n_channels,)
         The same, per channel.
     n_blind_ : int
-        Samples since :meth:`reset` with no usable channel (pure prediction).
+        Samples since :meth:`reset` at which no channel was used, so that the estimate is the model's pure
+        prediction: no channel live (mask False or NaN everywhere), or every live one rejected by the gate.
     std_ : ndarray (n_channels,)
         Standard deviation of the latest estimate of each channel's true (noise-free) value (channel units).
     input_estimate_ : ndarray (n_unknown,)
-        Latest estimate of the unknown loads (input units; deviations from their operating-point mean).
+        Latest estimate of the unknown loads (input units; deviations from the operating point).
 
     Notes
     -----
-    Per sample, :meth:`update` takes the prior, removes the rows of ``H`` and ``R`` of lost channels (mask
+    Per sample, :meth:`update` takes the prior, removes the rows of ``H`` and ``R`` of the lost channels (mask
     False or value NaN), gates the rest, makes the Kalman update with the remaining rows, reports the posterior
-    and predicts to the next sample. With no usable channel (total blackout) the update is skipped: the
-    estimate is the model's pure prediction and :attr:`std_` grows accordingly; when channels return, the
-    filter recovers without a restart. The estimate returned for every channel, live or lost, is the posterior
-    mean of its noise-free value. Memory is O(1) in time; the work per sample is a few small matrix products.
+    and predicts to the next sample. With no usable channel (total blackout, or every live channel gated) the
+    update is skipped: the estimate is the model's pure prediction and :attr:`std_` grows accordingly; when
+    channels return the filter recovers by itself. Every channel, live or lost, is reported as the posterior
+    mean of its noise-free value, so live channels come out slightly denoised. Memory is O(1) in time; the work
+    per sample is a few small matrix products (row selections are cached per mask pattern).
 
-    Gating is per channel on the prior innovation, in one pass. A spike or a sensor stuck far from the truth is
-    rejected; a stuck value within the gate still pulls the estimate. After a long blackout the prior is wide,
-    so the gate is wide too.
+    Gating is per channel, on its leave-one-out residual: the channel against the prediction from the prior
+    *and the other channels* of the sample, in standard deviations, ``|(S^-1 e)_i| / sqrt((S^-1)_ii)`` with
+    ``e`` the prior innovations and ``S`` their covariance (a standard normal under the model, like the prior
+    innovation ``e_i / sqrt(S_ii)``). The worst channel above the gate is rejected and the test is repeated on the
+    rest. A spike or a stuck sensor disagrees with its neighbours and is rejected; a stuck value that stays within
+    the gate still pulls the estimate. The other channels vouch for the state, so a prior that is off does not lock
+    the sensors out: after a blackout the model's prediction is typically much further off than its covariance
+    says (the real loads are not the AR(1) process the model assumes), and a test on the prior innovation would
+    reject every returning channel for seconds. With a single live channel the test is the prior-innovation one.
+
+    The noise model is white: slowly varying (coloured) sensor errors are read as structural response, which
+    mainly makes :attr:`std_` optimistic for channels next to such sensors.
 
     Examples
     --------
@@ -149,6 +191,8 @@ class KalmanSensor:
         process_noise: float | None = None,
         measurement_noise: float | Sequence[float] | None = None,
         gate_sigma: float | None = 5.0,
+        em_iter: int = 10,
+        em_tol: float = 1e-3,
         max_fit_samples: int = 60_000,
     ) -> None:
         self.system = system
@@ -159,6 +203,8 @@ class KalmanSensor:
         self.process_noise = process_noise
         self.measurement_noise = measurement_noise
         self.gate_sigma = gate_sigma
+        self.em_iter = em_iter
+        self.em_tol = em_tol
         self.max_fit_samples = max_fit_samples
 
     # --------------------------------------------------------------------------------------------- model
@@ -167,7 +213,10 @@ class KalmanSensor:
         dt = _positive_float(self.dt, "dt")
         if self.force_model not in ("ar1", "random_walk"):
             raise ValueError(f"force_model must be 'ar1' or 'random_walk', got {self.force_model!r}")
-        taus = np.atleast_1d(np.asarray(self.force_time_constant, dtype=float))
+        try:
+            taus = np.atleast_1d(np.asarray(self.force_time_constant, dtype=float))
+        except (TypeError, ValueError):
+            taus = np.array([np.nan])
         if taus.ndim != 1 or taus.size == 0 or not np.all(np.isfinite(taus)) or np.any(taus <= 0):
             raise ValueError(
                 f"force_time_constant must be a positive finite number of seconds (or a non-empty sequence of "
@@ -175,11 +224,21 @@ class KalmanSensor:
             )
         if self.process_noise is not None:
             _positive_float(self.process_noise, "process_noise")
-        if self.gate_sigma is not None and not (isinstance(self.gate_sigma, (int, float, np.number))
-                                                and self.gate_sigma > 0 and not math.isnan(self.gate_sigma)):
-            raise ValueError(f"gate_sigma must be a positive number, inf or None, got {self.gate_sigma!r}")
-        if not isinstance(self.max_fit_samples, (int, np.integer)) or self.max_fit_samples < 100:
-            raise ValueError(f"max_fit_samples must be an integer >= 100, got {self.max_fit_samples!r}")
+        gate = self.gate_sigma
+        if gate is not None and not (isinstance(gate, (int, float, np.number)) and not isinstance(gate, bool)
+                                     and gate > 0):
+            raise ValueError(f"gate_sigma must be a positive number, inf or None, got {gate!r}")
+        if not isinstance(self.em_iter, (int, np.integer)) or isinstance(self.em_iter, bool) or self.em_iter < 0:
+            raise ValueError(f"em_iter must be an integer >= 0, got {self.em_iter!r}")
+        if self.em_tol is None or not (float(self.em_tol) >= 0 and math.isfinite(float(self.em_tol))):
+            raise ValueError(f"em_tol must be a finite number >= 0, got {self.em_tol!r}")
+        if not isinstance(self.max_fit_samples, (int, np.integer)) or self.max_fit_samples < _MIN_SEGMENT:
+            raise ValueError(f"max_fit_samples must be an integer >= {_MIN_SEGMENT}, got {self.max_fit_samples!r}")
+        if np.max(np.linalg.eigvals(a).real) >= 0:
+            raise ValueError(
+                "system: the state matrix A has eigenvalues with non-negative real part; the sensor needs a "
+                "stable model (its stationary response scales the states and loads)"
+            )
         unknown = _resolve_unknown(self.unknown_inputs, in_names, tuple_system=not hasattr(self.system, "A"))
         self._a, self._b, self._c, self._d = a, b, c, d
         self._in_names, self._out_names = in_names, out_names
@@ -188,16 +247,12 @@ class KalmanSensor:
         self._iu = unknown
         self._ik = [i for i in range(b.shape[1]) if i not in unknown]
 
-    def _nominal_output_variance(self, tau: float) -> np.ndarray:
-        """Stationary output variance per channel (rows) for each unknown input alone at unit variance (cols)."""
+    def _nominal_force_std(self, tau: float, signal_var: np.ndarray) -> np.ndarray:
+        """Per load: the stationary std at which that load alone (AR(1), time constant tau) would give the
+        channels their variance on average (relative to each channel's variance)."""
         a, b, c, d = self._a, self._b, self._c, self._d
         n = a.shape[0]
-        out = np.zeros((c.shape[0], len(self._iu)))
-        if np.max(np.linalg.eigvals(a).real) >= 0:
-            raise ValueError(
-                "system: the state matrix A has eigenvalues with non-negative real part; the sensor needs a stable "
-                "model (stationary responses) to scale its loads"
-            )
+        out = np.empty(len(self._iu))
         for j, iu in enumerate(self._iu):
             aa = np.zeros((n + 1, n + 1))
             aa[:n, :n] = a
@@ -207,17 +262,18 @@ class KalmanSensor:
             qq[n, n] = 2.0 / tau
             p = sla.solve_continuous_lyapunov(aa, -qq)
             cc = np.hstack([c, d[:, [iu]]])
-            out[:, j] = np.einsum("ij,jk,ik->i", cc, p, cc)
+            v = np.einsum("ij,jk,ik->i", cc, p, cc)
+            out[j] = 1.0 / math.sqrt(max(float(np.mean(v / signal_var)), 1e-300))
         return out
 
     def _build(self, tau: float, force_std: np.ndarray) -> dict:
-        """Scaled, discretised augmented model for one load time constant (process noise at alpha = 1)."""
+        """Scaled, discretised augmented model (loads at unit nominal variance)."""
         a, b, c, d = self._a, self._b, self._c, self._d
-        n, p = a.shape[0], len(self._iu)
+        n, p, nk = a.shape[0], len(self._iu), len(self._ik)
         na = n + p
         bf = b[:, self._iu] * force_std
-        df = d[:, self._iu] * force_std
-        # continuous augmented model in (x, f / force_std); AR(1) for the stationary scaling in every case
+        phi = math.exp(-self._dt / tau)
+        # state scaling: stationary std of x under unit-variance AR(1) loads
         aa = np.zeros((na, na))
         aa[:n, :n] = a
         aa[:n, n:] = bf
@@ -226,43 +282,36 @@ class KalmanSensor:
         qc[n:, n:] = np.eye(p) * (2.0 / tau)
         pst = sla.solve_continuous_lyapunov(aa, -qc)
         sx = np.sqrt(np.clip(np.diag(pst)[:n], 0.0, None))
-        sx = np.where(np.isfinite(sx) & (sx > 1e-300), sx, 1.0)
-        if self.force_model == "random_walk":
-            aa[n:, n:] = 0.0
+        sx = np.where(np.isfinite(sx) & (sx > 1e-150), sx, 1.0)
         m = np.concatenate([sx, np.ones(p)])
-        a_s = aa / m[:, None] * m[None, :]
-        bk = np.zeros((na, len(self._ik)))
-        bk[:n] = b[:, self._ik]
-        bk /= m[:, None]
-        h = np.hstack([c, df]) * m[None, :] / self.scale_[:, None]
-        dk = d[:, self._ik] / self.scale_[:, None]
-        # exact discretisation: ZOH on the known inputs, Van Loan for the process noise
-        nk = len(self._ik)
+        # exact discretisation, zero-order hold of the loads and of the known inputs
         big = np.zeros((na + nk, na + nk))
-        big[:na, :na] = a_s * self._dt
-        big[:na, na:] = bk * self._dt
+        big[:n, :n] = a * self._dt
+        big[:n, n:na] = bf * self._dt
+        big[:n, na:] = b[:, self._ik] * self._dt
         e = sla.expm(big)
-        f, gk = e[:na, :na], e[:na, na:]
-        vl = np.zeros((2 * na, 2 * na))
-        vl[:na, :na] = -a_s * self._dt
-        vl[:na, na:] = qc * self._dt
-        vl[na:, na:] = a_s.T * self._dt
-        ev = sla.expm(vl)
-        q1 = f @ ev[:na, na:]
-        q1 = 0.5 * (q1 + q1.T)
-        p0 = pst / m[:, None] / m[None, :]
-        p0 = 0.5 * (p0 + p0.T)
-        return {"tau": tau, "F": f, "Gk": gk, "H": h, "Dk": dk, "Q1": q1, "P0": p0, "sx": sx, "force_std": force_std}
+        f = e[:na, :na] / m[:, None] * m[None, :]
+        f[n:, n:] = (1.0 if self.force_model == "random_walk" else phi) * np.eye(p)
+        gk = e[:na, na:] / m[:, None]
+        h = np.hstack([c, d[:, self._iu] * force_std]) * m[None, :] / self.scale_[:, None]
+        dk = d[:, self._ik] / self.scale_[:, None]
+        return {"tau": tau, "phi": phi, "F": f, "Gk": gk, "H": h, "Dk": dk, "force_std": force_std, "n": n, "p": p}
+
+    def _q(self, model: dict, q_ff: np.ndarray) -> np.ndarray:
+        n, p = model["n"], model["p"]
+        q = np.zeros((n + p, n + p))
+        q[n:, n:] = q_ff
+        return q
 
     # ------------------------------------------------------------------------------------------------ fit
     def fit(self, Y, mask=None) -> KalmanSensor:
-        """Learn channel means, measurement noise and load levels from training data.
+        """Learn channel means, measurement noise and the load model from training data.
 
         Parameters
         ----------
         Y : array_like (n_samples, n_channels) or list of them
             Training records in channel units, columns in the order of the model outputs. NaN marks missing
-            samples.
+            samples; the likelihood search uses the stretches where every channel is available.
         mask : array_like of bool, optional
             Same shape as ``Y`` (or ``(n_channels,)``, or a list matching a list ``Y``); False = not available.
 
@@ -275,11 +324,27 @@ class KalmanSensor:
         ------
         ValueError
             Bad model or parameters, wrong channel count, mask shape, too little finite data.
+
+        Notes
+        -----
+        The likelihood is computed on the complete stretches (at least ``_MIN_SEGMENT`` samples with every channel).
+        The steady-state filter of a reference model runs over each stretch; after the first ``_LEAD_S`` seconds
+        (at most a fifth of the stretch), which only condition it, the stretch is cut into pieces of at most
+        ``_MAX_PIECE`` samples (bounded by memory for large models). Each piece starts from that filter's
+        prediction and steady-state covariance, and its likelihood is the exact one, by the time-varying filter,
+        of the model being evaluated. For the reference model itself this is its steady-state innovation
+        likelihood of the stretch after the lead, which is how the grid search scores every grid point (each its
+        own reference). EM keeps the best grid point as the reference: the start of every piece is then fixed,
+        the E-step is the exact time-varying smoother of the pieces and the M-step maximises the expected
+        complete-data likelihood over the load-increment covariance and the measurement noise, so every EM step
+        raises the likelihood it reports. Conditioning the pieces on the past rather than starting them from the
+        stationary covariance keeps the filter in the regime it streams in: pieces that each start from scratch
+        spend much of their length in the start-up transient of the slow platform states, and a model fitted to
+        them comes out with intervals too narrow for some hidden channels.
         """
         self._check_params()
-        records = _as_records(Y, mask, self._c.shape[0])
         n_ch = self._c.shape[0]
-        # means and scales from all available data
+        records = _as_records(Y, mask, n_ch)
         stacked = np.vstack(records)
         counts = np.isfinite(stacked).sum(axis=0)
         if np.any(counts < 2 * _DIFF_ORDER + 2):
@@ -288,106 +353,221 @@ class KalmanSensor:
         self.mean_ = np.nanmean(stacked, axis=0)
         std = np.nanstd(stacked, axis=0)
         self.scale_ = np.where(std > 0, std, 1.0)
-        # measurement noise: white floor from high-order differences (signal << Nyquist contributes ~nothing)
+        del stacked
         if self.measurement_noise is None:
-            num = np.zeros(n_ch)
-            den = np.zeros(n_ch)
-            for r in records:
-                dd = np.diff(r, n=_DIFF_ORDER, axis=0)
-                ok = np.isfinite(dd)
-                num += np.where(ok, dd * dd, 0.0).sum(axis=0)
-                den += ok.sum(axis=0)
-            noise_std = np.sqrt(num / np.maximum(den, 1) / _DIFF_GAIN)
+            noise_std = _noise_floor(records)
         else:
-            noise_std = np.broadcast_to(np.asarray(self.measurement_noise, dtype=float), (n_ch,)).copy()
+            noise_std = np.array(np.broadcast_to(np.asarray(self.measurement_noise, dtype=float), (n_ch,)))
             if not np.all(np.isfinite(noise_std)) or np.any(noise_std < 0):
                 raise ValueError(f"measurement_noise must be finite and >= 0, got {self.measurement_noise!r}")
         noise_std = np.maximum(noise_std, _MIN_NOISE_REL * self.scale_)
         self.measurement_noise_std_ = noise_std
         self._r = (noise_std / self.scale_) ** 2
-        # relative load levels: match the stationary output variances (minus noise) by non-negative least squares
         signal_var = np.maximum(std**2 - noise_std**2, (0.01 * std) ** 2)
-        train = [(r - self.mean_) / self.scale_ for r in _trim(records, self.max_fit_samples)]
-        best = None
+        signal_var = np.where(signal_var > 0, signal_var, 1.0)
+
+        segments = _complete_segments(records, self.max_fit_samples)
+        if not segments:
+            raise ValueError(
+                f"Y: fit needs stretches of at least {_MIN_SEGMENT} samples where every channel is available"
+            )
+        segments = [(s - self.mean_) / self.scale_ for s in segments]
+        n_aug = self._a.shape[0] + len(self._iu)
+        self._piece_len = max(_MIN_SEGMENT, min(_MAX_PIECE, _SMOOTHER_BYTES // (16 * n_aug * n_aug)))
+        self._leads = [min(int(round(_LEAD_S / self._dt)), s.shape[0] // 5) for s in segments]
+
+        # grid search: load time constant(s) and overall level
         self.search_ = []
+        best = None
         for tau in self._taus:
-            v = self._nominal_output_variance(float(tau))
-            w = v / signal_var[:, None]
-            coef, _ = nnls(w, np.ones(n_ch))
-            # unit-variance load j alone would explain the data with this std; keep every load slightly alive
-            alone = 1.0 / np.sqrt(np.maximum(w.mean(axis=0), 1e-300))
-            force_var = np.maximum(coef, (_MIN_FORCE_REL * alone) ** 2)
-            model = self._build(float(tau), np.sqrt(force_var))
+            model = self._build(float(tau), self._nominal_force_std(float(tau), signal_var))
+            q_unit = (1.0 - model["phi"] ** 2) * np.eye(model["p"])
             if self.process_noise is not None:
                 alpha = float(self.process_noise)
-                ll = _log_likelihood(model, alpha, self._r, train, self._dt)
-                self.search_.append({"force_time_constant": float(tau), "process_noise": alpha,
-                                     "log_likelihood": ll})
+                ll, start = self._loglik_at(model, alpha**2 * q_unit, segments)
+                self.search_.append({"force_time_constant": float(tau), "process_noise": alpha, "log_likelihood": ll})
             else:
-                alpha, ll = self._search_alpha(model, train, float(tau))
+                alpha, ll, start = self._search_alpha(model, q_unit, segments)
             if best is None or ll > best[2]:
-                best = (model, alpha, ll)
-        model, alpha, ll = best
+                best = (model, alpha, ll, start)
+        model, alpha, ll, start = best
+        q_ff = alpha**2 * (1.0 - model["phi"] ** 2) * np.eye(model["p"])
+        self.em_log_likelihood_ = []
+        if self.process_noise is None and self.em_iter > 0:
+            q_ff, self._r, ll = self._em(model, q_ff, self._r, ll, *start, learn_r=self.measurement_noise is None)
+            self.measurement_noise_std_ = np.sqrt(self._r) * self.scale_
         self._model = model
+        self._q_ff = q_ff
         self.force_time_constant_ = float(model["tau"])
         self.process_noise_ = alpha
         self.log_likelihood_ = ll
-        self.force_std_ = model["force_std"] * alpha
+        phi_ref = model["phi"]
+        self.force_std_ = np.sqrt(np.diag(q_ff) / (1.0 - phi_ref**2)) * model["force_std"]
+        dq = np.sqrt(np.diag(q_ff))
+        self.force_corr_ = q_ff / np.outer(dq, dq)
         self.n_channels_ = n_ch
         self.channels_ = list(self._out_names)
         self.unknown_inputs_ = [self._in_names[i] for i in self._iu]
         self.known_inputs_ = [self._in_names[i] for i in self._ik]
-        self._set_alpha(alpha)
+        self._prepare()
         self.reset()
         return self
 
-    def _search_alpha(self, model: dict, train: list[np.ndarray], tau: float) -> tuple[float, float]:
-        """Maximise the innovation log-likelihood over log10(alpha): coarse grid, extension, parabolic step."""
+    def _initial_cov(self, model: dict, q_ff: np.ndarray) -> np.ndarray:
+        """Covariance of the state at the start of a stream: the stationary covariance of the model with AR(1)
+        loads (also for the random walk, whose loads have no stationary covariance)."""
+        f_ar = model["F"].copy()
+        n, p = model["n"], model["p"]
+        f_ar[n:, n:] = model["phi"] * np.eye(p)
+        p0 = sla.solve_discrete_lyapunov(f_ar, self._q(model, q_ff))
+        return 0.5 * (p0 + p0.T)
+
+    def _loglik_at(self, model: dict, q_ff: np.ndarray, segments: list[np.ndarray]):
+        """Log-likelihood per sample at the load covariance q_ff (and the current measurement noise), and the
+        conditioned pieces (groups, prior covariance) that define it, None if the model has no steady state."""
+        start = _conditioned_pieces(segments, self._leads, self._piece_len, model["F"], self._q(model, q_ff),
+                                    model["H"], self._r)
+        if start is None:
+            return -math.inf, None
+        return start[2], start[:2]  # for its own reference model the exact filter is the steady-state one
+
+    def _search_alpha(self, model: dict, q_unit: np.ndarray, segments: list[np.ndarray]):
+        """Maximise the log-likelihood over log10(alpha): coarse grid, extension, parabolic steps. Returns
+        alpha, its log-likelihood and its conditioned pieces."""
         cache: dict[float, float] = {}
+        tau = float(model["tau"])
+        best: list = [-math.inf, None]  # log-likelihood and conditioned pieces of the best point so far
 
         def ll_at(logit: float) -> float:
             key = round(logit, 6)
             if key not in cache:
-                cache[key] = _log_likelihood(model, 10.0**logit, self._r, train, self._dt)
-                self.search_.append({"force_time_constant": tau, "process_noise": 10.0**logit,
-                                     "log_likelihood": cache[key]})
+                ll, start = self._loglik_at(model, 10.0 ** (2 * key) * q_unit, segments)
+                cache[key] = ll
+                if ll > best[0]:
+                    best[:] = [ll, start]
+                self.search_.append({"force_time_constant": tau, "process_noise": 10.0**key, "log_likelihood": ll})
             return cache[key]
 
         step = 0.5
-        grid = list(np.arange(-2.0, 2.0 + 1e-9, step))
-        for g in grid:
-            ll_at(g)
+        for g in np.arange(-2.0, 2.0 + 1e-9, step):
+            ll_at(float(g))
         for _ in range(6):  # extend the grid while the maximum sits on its edge
-            k_best = max(cache, key=cache.get)
+            k_best = max(cache, key=ll_at)
             if k_best == min(cache):
                 ll_at(k_best - step)
             elif k_best == max(cache):
                 ll_at(k_best + step)
             else:
                 break
-        for h in (step, step / 4):  # parabolic refinement around the best point
-            k_best = max(cache, key=cache.get)
+        for h in (step / 2, step / 8):  # parabolic refinement around the best point
+            k_best = max(cache, key=ll_at)
             y0, ym, yp = ll_at(k_best), ll_at(k_best - h), ll_at(k_best + h)
             curv = ym - 2 * y0 + yp
-            if curv < 0:
-                shift = 0.5 * h * (ym - yp) / curv
-                ll_at(k_best + float(np.clip(shift, -h, h)))
-        k_best = max(cache, key=cache.get)
-        return 10.0**k_best, cache[k_best]
+            if np.isfinite(curv) and curv < 0:
+                ll_at(k_best + float(np.clip(0.5 * h * (ym - yp) / curv, -h, h)))
+        k_best = max(cache, key=ll_at)
+        if not np.isfinite(cache[k_best]):
+            raise ValueError("fit: the innovation likelihood is not finite anywhere on the grid (model unusable?)")
+        return 10.0**k_best, cache[k_best], best[1]
 
-    def _set_alpha(self, alpha: float) -> None:
+    def _em(self, model: dict, q_ff: np.ndarray, r: np.ndarray, ll: float, groups: dict, p0: np.ndarray,
+            learn_r: bool) -> tuple[np.ndarray, np.ndarray, float]:
+        """EM (Shumway & Stoffer 1982) on the load-increment covariance and (if learn_r) the white measurement
+        noise, accelerated by SQUAREM (Varadhan & Roland 2008: two EM steps, a squared extrapolation, kept only
+        if it raises the likelihood). At most ``em_iter`` E-steps.
+
+        The E-step is the exact time-varying filter and smoother of the pieces ``groups``, each from its fixed
+        start (mean, common covariance ``p0``) given by the starting point's steady-state filter: the M-step
+        maximises the expected complete-data likelihood over the load covariance and the noise with those starts
+        fixed, so every EM step raises the likelihood it reports. ``em_log_likelihood_`` lists the iterates
+        (rejected extrapolations are not iterates). Returns the best (q_ff, r, log-likelihood)."""
+        n, p = model["n"], model["p"]
+        phi = 1.0 if self.force_model == "random_walk" else model["phi"]
+        sel = slice(n, n + p)
+        r_min = _MIN_NOISE_REL**2
+        iu = np.triu_indices(p)
+        d0 = np.sqrt(np.diag(q_ff))
+        norm = np.outer(d0, d0)[iu]  # Q_f entries relative to the starting levels; log for R
+
+        def pack(q, rr):
+            return np.concatenate([q[iu] / norm, np.log(rr)]) if learn_r else q[iu] / norm
+
+        def unpack(theta):
+            q = np.zeros((p, p))
+            q[iu] = theta[:norm.size] * norm
+            q = q + np.triu(q, 1).T
+            w, v = np.linalg.eigh(q)
+            q = (v * np.maximum(w, 1e-12 * max(float(w.max()), 1e-300))) @ v.T
+            rr = np.maximum(np.exp(theta[norm.size:]), r_min) if learn_r else r
+            return q, rr
+
+        def e_step(q, rr):
+            ll_e, mom = _ExactFilter(model["F"], self._q(model, q), model["H"], rr, p0).moments(groups, sel)
+            return (ll_e if math.isfinite(ll_e) else -math.inf), mom
+
+        def m_step(mom):
+            s11, s10, s00, r_s = mom
+            q = s11 - phi * (s10 + s10.T) + phi**2 * s00
+            w, v = np.linalg.eigh(0.5 * (q + q.T))
+            q = (v * np.maximum(w, 1e-12 * max(float(w.max()), 1e-300))) @ v.T
+            return q, (np.maximum(r_s, r_min) if learn_r else r)
+
+        budget = int(self.em_iter)
+        ll0, mom0 = e_step(q_ff, r)  # the starting point again (same prior, same likelihood as the search)
+        budget -= 1
+        if not math.isfinite(ll0):
+            return q_ff, r, ll
+        log = self.em_log_likelihood_
+        log.append(ll0)
+        theta0 = (q_ff, r)
+        best = (q_ff, r, ll0)
+        while budget >= 2:
+            theta1 = m_step(mom0)
+            ll1, mom1 = e_step(*theta1)
+            budget -= 1
+            if not math.isfinite(ll1):
+                break
+            log.append(ll1)
+            if ll1 > best[2]:
+                best = (*theta1, ll1)
+            theta2 = m_step(mom1)
+            ll2, mom2 = e_step(*theta2)
+            budget -= 1
+            if not math.isfinite(ll2):
+                break
+            log.append(ll2)
+            cand = (theta2, ll2, mom2)
+            x0, x1, x2 = pack(*theta0), pack(*theta1), pack(*theta2)
+            step, curv = x1 - x0, x2 - 2 * x1 + x0
+            if budget >= 1 and np.linalg.norm(curv) > 0:
+                alpha = min(-np.linalg.norm(step) / np.linalg.norm(curv), -1.0)
+                theta_x = unpack(x0 - 2 * alpha * step + alpha**2 * curv)
+                ll_x, mom_x = e_step(*theta_x)
+                budget -= 1
+                if ll_x > ll2:
+                    cand = (theta_x, ll_x, mom_x)
+                    log.append(ll_x)
+            theta_new, ll_new, mom_new = cand
+            gain = ll_new - ll0
+            theta0, ll0, mom0 = theta_new, ll_new, mom_new
+            if ll0 > best[2]:
+                best = (*theta0, ll0)
+            if gain < self.em_tol:
+                break
+        return best
+
+    def _prepare(self) -> None:
         mdl = self._model
         self._F = np.ascontiguousarray(mdl["F"])
         self._Ft = np.ascontiguousarray(mdl["F"].T)
         self._Gk = mdl["Gk"]
         self._H = np.ascontiguousarray(mdl["H"])
         self._Dk = mdl["Dk"]
-        self._Q = alpha**2 * mdl["Q1"]
-        self._P0 = alpha**2 * mdl["P0"]
+        self._Q = self._q(mdl, self._q_ff)
+        self._n = mdl["n"]
+        self._unscale_f = mdl["force_std"]
+        self._P0 = self._initial_cov(mdl, self._q_ff)
         self._rows: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        n = self._a.shape[0]
-        self._unscale_f = mdl["force_std"]  # scaled load -> input units
-        self._n = n
 
     # -------------------------------------------------------------------------------------------- streaming
     def _check_fitted(self) -> None:
@@ -395,7 +575,7 @@ class KalmanSensor:
             raise ValueError("this KalmanSensor is not fitted yet: call fit(Y_train) first")
 
     def reset(self) -> None:
-        """Start a new stream: state at its mean (zero deviation), covariance at its stationary value.
+        """Start a new stream: states at their mean (zero deviation), covariance at its stationary value.
 
         Raises
         ------
@@ -429,12 +609,12 @@ class KalmanSensor:
         y : array_like (n_channels,)
             Measured values in channel units (anything, e.g. NaN, where ``mask`` is False).
         mask : array_like of bool (n_channels,), optional
-            True = sensor available (default: all). A NaN where mask is True is a dropout.
+            True = sensor available (default: every finite value). A NaN where mask is True is a dropout.
         u : array_like (n_known,), optional
             Known inputs (:attr:`known_inputs_`, input units) applied from this sample to the next
             (zero-order hold); default zero.
         return_std : bool
-            Also return the standard deviation of the estimate (also kept in :attr:`std_`).
+            Also return the standard deviation of the estimate (always kept in :attr:`std_`).
 
         Returns
         -------
@@ -446,7 +626,7 @@ class KalmanSensor:
         Raises
         ------
         ValueError
-            Unfitted sensor, wrong length of ``y``, ``mask`` or ``u``, non-finite ``u``.
+            Unfitted sensor; ``y``, ``mask`` or ``u`` of the wrong length; non-finite ``u``.
         """
         self._check_fitted()
         if not hasattr(self, "_x"):
@@ -454,9 +634,7 @@ class KalmanSensor:
         y = np.asarray(y, dtype=float)
         n_ch = self.n_channels_
         if y.shape != (n_ch,):
-            raise ValueError(
-                f"y must have shape ({n_ch},) (one value per model output: {n_ch} channels), got {y.shape}"
-            )
+            raise ValueError(f"y must have shape ({n_ch},) (one value per model output), got {y.shape}")
         if mask is None:
             live = np.isfinite(y)
         else:
@@ -470,6 +648,7 @@ class KalmanSensor:
             if uk.shape != (len(self._ik),) or not np.all(np.isfinite(uk)):
                 raise ValueError(f"u must be {len(self._ik)} finite known inputs {self.known_inputs_}, got {u!r}")
         x, p = self._x, self._P
+        updated = False
         if live.any():
             idx, h, r = self._rows_for(live)
             z = (y[idx] - self.mean_[idx]) / self.scale_[idx]
@@ -477,30 +656,41 @@ class KalmanSensor:
                 z = z - self._Dk[idx] @ uk
             pht = p @ h.T
             s = h @ pht
-            s[np.diag_indices_from(s)] += r
+            s.flat[:: s.shape[0] + 1] += r
             e = z - h @ x
             gate = self.gate_sigma
-            if gate is not None and gate != math.inf:
-                bad = np.abs(e) > gate * np.sqrt(np.diag(s))
-                if bad.any():
-                    self.n_gated_ += int(bad.sum())
-                    self.gated_counts_[idx[bad]] += 1
-                    keep = ~bad
-                    pht, s, e = pht[:, keep], s[np.ix_(keep, keep)], e[keep]
-            if e.size:
-                k = np.linalg.solve(s, pht.T).T
-                x = x + k @ e
-                p = p - k @ pht.T
+            gating = gate is not None and gate != math.inf
+            while e.size:
+                chol = _inv_chol(s)  # S = U'U, ui = U^-1, S^-1 = ui ui'
+                if chol is None:
+                    break
+                ui = chol[0]
+                we = ui.T @ e
+                if gating:
+                    # leave-one-out residual of each channel in standard deviations, (S^-1 e)_i / sqrt((S^-1)_ii):
+                    # the channel against the prediction from the prior *and the other channels*
+                    loo = np.abs(ui @ we) / np.sqrt(np.einsum("ij,ij->i", ui, ui))
+                    worst = int(np.argmax(loo))
+                    if loo[worst] > gate:
+                        self.n_gated_ += 1
+                        self.gated_counts_[idx[worst]] += 1
+                        keep = np.arange(e.size) != worst
+                        idx, pht, s, e = idx[keep], pht[:, keep], s[np.ix_(keep, keep)], e[keep]
+                        continue
+                w = ui.T @ pht.T  # U^-T H P: gain K = w' U^-T, K S K' = w' w
+                x = x + w.T @ we
+                p = p - w.T @ w
                 p = 0.5 * (p + p.T)
-            else:
-                self.n_blind_ += 1
-        else:
+                updated = True
+                break
+        if not updated:
             self.n_blind_ += 1
-        est = self._H @ x
+        hx = self._H @ x
         if uk is not None:
-            est = est + self._Dk @ uk
-        est = self.mean_ + self.scale_ * est
-        self.std_ = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", self._H, p, self._H), 0.0)) * self.scale_
+            hx = hx + self._Dk @ uk
+        est = self.mean_ + self.scale_ * hx
+        hp = self._H @ p
+        self.std_ = np.sqrt(np.maximum((hp * self._H).sum(axis=1), 0.0)) * self.scale_
         self.input_estimate_ = x[self._n:] * self._unscale_f
         # predict to the next sample
         xn = self._F @ x
@@ -513,14 +703,14 @@ class KalmanSensor:
         return est
 
     def reconstruct(self, Y, mask=None, *, U=None, return_std: bool = False):
-        """Estimate a whole record by streaming it through :meth:`update` from a :meth:`reset`.
+        """Estimate a whole record by streaming it through :meth:`update` after a :meth:`reset`.
 
         Parameters
         ----------
         Y : array_like (n_samples, n_channels)
             Record in channel units.
         mask : array_like of bool, optional
-            ``(n_samples, n_channels)`` or ``(n_channels,)`` for a fixed mask; default: the finite entries.
+            ``(n_samples, n_channels)``, or ``(n_channels,)`` for a fixed mask; default: the finite entries.
         U : array_like (n_samples, n_known), optional
             Known inputs per sample.
         return_std : bool
@@ -532,6 +722,11 @@ class KalmanSensor:
             Identical to calling :meth:`update` sample by sample.
         std : ndarray (n_samples, n_channels)
             Only if ``return_std``.
+
+        Raises
+        ------
+        ValueError
+            Unfitted sensor, wrong shapes.
         """
         self._check_fitted()
         Y = np.asarray(Y, dtype=float)
@@ -555,6 +750,131 @@ class KalmanSensor:
             if sd is not None:
                 sd[k] = self.std_
         return (out, sd) if return_std else out
+
+
+# ------------------------------------------------------------------------------------------ exact filter tools
+class _ExactFilter:
+    """Exact (time-varying) Kalman filter and Rauch-Tung-Striebel smoother of ``z[k+1] = F z[k] + w``,
+    ``y[k] = H z[k] + v`` (covariances Q and diag r), every piece starting from ``z[0] ~ N(m, P0)`` with its own
+    mean ``m`` and a common ``P0``.
+
+    The training pieces are complete (no missing channel), so the covariance recursion does not depend on the data:
+    it runs once for the longest piece and every piece shares it (a shorter piece uses its beginning); the means of
+    all pieces of one length are propagated together as the columns of one matrix. Once the filter covariances stop
+    changing (to rounding), the recursion stops and the converged values are used.
+    """
+
+    def __init__(self, f: np.ndarray, q: np.ndarray, h: np.ndarray, r: np.ndarray, p0: np.ndarray) -> None:
+        self.f, self.q, self.h, self.r, self.p0 = f, q, h, r, p0
+
+    def loglik(self, groups: dict[int, tuple[np.ndarray, np.ndarray]]) -> float:
+        """Exact log-likelihood per sample of the pieces (``groups``: length -> (data (length, n_out, n_pieces),
+        initial means (n_states, n_pieces)))."""
+        return self._run(groups, smooth=False)[0]
+
+    def moments(self, groups: dict[int, tuple[np.ndarray, np.ndarray]], sel: slice):
+        """Exact log-likelihood per sample and the EM statistics: the smoothed second moments E[z1 z1'],
+        E[z1 z0'], E[z0 z0'] of the ``sel`` block (z1 = z[k+1], z0 = z[k]) averaged over the pairs of consecutive
+        samples, and E[(y - H z)^2] per channel averaged over the samples."""
+        return self._run(groups, smooth=True, sel=sel)
+
+    def _run(self, groups: dict[int, tuple[np.ndarray, np.ndarray]], smooth: bool, sel: slice | None = None):
+        f, q, h, r = self.f, self.q, self.h, self.r
+        na, m = f.shape[0], h.shape[0]
+        ft = f.T
+        lengths = sorted(groups, reverse=True)
+        n_max = lengths[0]
+        ys = {n: groups[n][0] for n in lengths}
+        zp = {n: groups[n][1].copy() for n in lengths}
+        n_samples = sum(n * ys[n].shape[2] for n in lengths)
+        fail = (-math.inf, None) if smooth else (-math.inf,)
+        if smooth:
+            pf_all = np.empty((n_max, na, na))
+            j_all = np.empty((n_max, na, na))
+            zp_all = {n: np.empty((n, na, ys[n].shape[2])) for n in lengths}
+            zf_all = {n: np.empty((n, na, ys[n].shape[2])) for n in lengths}
+        const = m * math.log(2.0 * math.pi)
+        total = 0.0
+        pp = self.p0
+        k_steady = n_max  # from this sample on the filter covariances have converged (to rounding)
+        # forward: time-varying filter (covariances shared by all pieces, means per length)
+        for k in range(n_max):
+            if k <= k_steady:
+                hp = h @ pp
+                s = hp @ h.T
+                s.flat[:: m + 1] += r
+                chol = _inv_chol(s)  # S = U'U, ui = U^-1
+                if chol is None:
+                    return fail
+                ui, logdet = chol
+                w = ui.T @ hp  # U^-T H P: gain K = w' U^-T, and K S K' = w' w
+                pf = pp - w.T @ w
+            for n in lengths:
+                if n <= k:
+                    break
+                we = ui.T @ (ys[n][k] - h @ zp[n])  # whitened innovations
+                total -= 0.5 * (float(np.einsum("ij,ij->", we, we)) + we.shape[1] * (logdet + const))
+                zf = zp[n] + w.T @ we
+                if smooth:
+                    zp_all[n][k] = zp[n]
+                    zf_all[n][k] = zf
+                zp[n] = f @ zf
+            if k < k_steady and k + 1 < n_max:
+                fpf = f @ pf
+                pp_next = fpf @ ft + q
+                pp_next = 0.5 * (pp_next + pp_next.T)
+                if smooth:
+                    chol = _inv_chol(pp_next)
+                    if chol is None:
+                        return fail
+                    jk = (chol[0] @ (chol[0].T @ fpf)).T  # J = Pf F' Pp^-1
+                if np.abs(pp_next - pp).max() <= _STEADY_TOL * np.abs(pp).max():
+                    k_steady = k + 1
+                pp = pp_next
+            if smooth:
+                pf_all[k] = pf
+                j_all[k] = jk if k < n_max - 1 else 0.0
+        ll = total / n_samples
+        if not math.isfinite(ll):
+            return fail
+        if not smooth:
+            return (ll,)
+        # backward: Rauch-Tung-Striebel smoother, means per length, covariances shared by the pieces of one length
+        p = sel.stop - sel.start
+        s11, s10, s00 = np.zeros((p, p)), np.zeros((p, p)), np.zeros((p, p))
+        res2 = np.zeros(m)
+        n_pairs = 0
+        for n in lengths:
+            c = ys[n].shape[2]
+            zs_all = np.empty((n, na, c))
+            zs = zf_all[n][n - 1]
+            zs_all[n - 1] = zs
+            ps = ps_last = pf_all[n - 1]
+            ps_sum = ps.copy()
+            jps_sum = np.zeros((na, na))
+            ps_steady = False  # Ps has converged while Pf and J are constant (k >= k_steady)
+            for k in range(n - 2, -1, -1):
+                jk = j_all[k]
+                zs = zf_all[n][k] + jk @ (zs - zp_all[n][k + 1])
+                zs_all[k] = zs
+                if not ps_steady or k < k_steady:
+                    jps = jk @ ps  # its transpose Ps[k+1] J[k]' is Cov(z[k+1], z[k] | all data)
+                    ps_next = pf_all[k] + (jps - pf_all[k] @ ft) @ jk.T  # Pf + J (Ps[k+1] - Pp[k+1]) J'
+                    ps_next = 0.5 * (ps_next + ps_next.T)
+                    ps_steady = k > k_steady and np.abs(ps_next - ps).max() <= _STEADY_TOL * np.abs(ps).max()
+                    ps = ps_next
+                jps_sum += jps
+                ps_sum += ps
+            fz = zs_all[:, sel, :]
+            s11 += np.einsum("kic,kjc->ij", fz[1:], fz[1:]) + c * (ps_sum - ps)[sel, sel]
+            s10 += np.einsum("kic,kjc->ij", fz[1:], fz[:-1]) + c * jps_sum[sel, sel].T
+            s00 += np.einsum("kic,kjc->ij", fz[:-1], fz[:-1]) + c * (ps_sum - ps_last)[sel, sel]
+            resid = ys[n] - np.einsum("ij,kjc->kic", h, zs_all)
+            res2 += np.einsum("kic,kic->i", resid, resid) + c * np.einsum("ij,jk,ik->i", h, ps_sum, h)
+            n_pairs += c * (n - 1)
+        if n_pairs == 0:
+            return -math.inf, None
+        return ll, (s11 / n_pairs, s10 / n_pairs, s00 / n_pairs, res2 / n_samples)
 
 
 # ------------------------------------------------------------------------------------------------- helpers
@@ -583,7 +903,7 @@ def _unpack_system(system):
     else:
         raise ValueError("system must be a continuous control.StateSpace or a tuple (A, B, C, D)")
     try:
-        a, b, c, d = (np.atleast_2d(np.asarray(m, dtype=float)) for m in (a, b, c, d))
+        a, b, c, d = (np.atleast_2d(np.asarray(mat, dtype=float)) for mat in (a, b, c, d))
     except (TypeError, ValueError):
         raise ValueError("system: A, B, C, D must be numeric matrices") from None
     n = a.shape[0]
@@ -592,7 +912,7 @@ def _unpack_system(system):
             f"system: inconsistent shapes A {a.shape}, B {b.shape}, C {c.shape}, D {d.shape} "
             "(expected A (n, n), B (n, m), C (p, n), D (p, m))"
         )
-    if not all(np.all(np.isfinite(m)) for m in (a, b, c, d)):
+    if not all(np.all(np.isfinite(mat)) for mat in (a, b, c, d)):
         raise ValueError("system: A, B, C, D must be finite")
     if in_names is None:
         in_names = [f"u[{i}]" for i in range(b.shape[1])]
@@ -620,7 +940,7 @@ def _resolve_unknown(unknown, in_names: list[str], tuple_system: bool) -> list[i
         if len(set(idx)) != len(idx):
             raise ValueError(f"unknown_inputs: duplicates in {unknown!r}")
     if not idx:
-        raise ValueError("unknown_inputs: at least one unknown input is needed (the loads driving the model)")
+        raise ValueError("unknown_inputs: at least one unknown input (a load driving the model) is needed")
     return sorted(idx)
 
 
@@ -628,7 +948,7 @@ def _as_records(Y, mask, n_ch: int) -> list[np.ndarray]:
     """Training data as a list of float arrays with NaN where unavailable."""
     if isinstance(Y, (list, tuple)) and len(Y) > 0 and np.ndim(Y[0]) == 2:
         ys = list(Y)
-        if mask is None or (not isinstance(mask, (list, tuple))):
+        if mask is None or not isinstance(mask, (list, tuple)):
             masks = [mask] * len(ys)
         else:
             masks = list(mask)
@@ -638,7 +958,10 @@ def _as_records(Y, mask, n_ch: int) -> list[np.ndarray]:
         ys, masks = [Y], [mask]
     out = []
     for i, (yi, mi) in enumerate(zip(ys, masks, strict=True)):
-        yi = np.array(yi, dtype=float)
+        try:
+            yi = np.array(yi, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"Y: record {i} is not a numeric array") from None
         if yi.ndim != 2 or yi.shape[1] != n_ch:
             raise ValueError(
                 f"Y: record {i} must have shape (n_samples, {n_ch}) (one column per model output), got {yi.shape}"
@@ -653,88 +976,114 @@ def _as_records(Y, mask, n_ch: int) -> list[np.ndarray]:
     return out
 
 
-def _trim(records: list[np.ndarray], max_samples: int) -> list[np.ndarray]:
-    out, left = [], max_samples
+def _noise_floor(records: list[np.ndarray]) -> np.ndarray:
+    """White-noise std per channel from 4th-order differences (signal far below Nyquist contributes ~nothing)."""
+    n_ch = records[0].shape[1]
+    num = np.zeros(n_ch)
+    den = np.zeros(n_ch)
     for r in records:
-        if left <= 0:
-            break
-        out.append(r[:left])
-        left -= min(left, r.shape[0])
+        dd = np.diff(r, n=_DIFF_ORDER, axis=0)
+        ok = np.isfinite(dd)
+        num += np.where(ok, dd * dd, 0.0).sum(axis=0)
+        den += ok.sum(axis=0)
+    return np.sqrt(num / np.maximum(den, 1) / _DIFF_GAIN)
+
+
+def _complete_segments(records: list[np.ndarray], max_samples: int) -> list[np.ndarray]:
+    """Stretches where every channel is finite, at least _MIN_SEGMENT long; at most max_samples in total, taken
+    in equal shares from the records (so that every training condition is represented)."""
+    out = []
+    quota = max(max_samples // len(records), _MIN_SEGMENT)
+    for r in records:
+        ok = np.all(np.isfinite(r), axis=1)
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(np.int8), [0]])))
+        left = quota
+        for start, stop in zip(edges[::2], edges[1::2], strict=True):
+            if stop - start >= _MIN_SEGMENT and left >= _MIN_SEGMENT:
+                take = min(stop - start, left)
+                out.append(r[start:start + take])
+                left -= take
     return out
 
 
-def _log_likelihood(model: dict, alpha: float, r: np.ndarray, records: list[np.ndarray], dt: float) -> float:
-    """Innovation log-likelihood per sample of the steady-state filter (missing samples: time-varying filter)."""
-    f, h = model["F"], model["H"]
-    q = alpha**2 * model["Q1"]
-    rr = np.diag(r)
-    m = h.shape[0]
-    try:
-        p = sla.solve_discrete_are(f.T, h.T, q, rr)
-    except (np.linalg.LinAlgError, ValueError):
-        return -np.inf
-    s = h @ p @ h.T + rr
-    try:
-        cs = sla.cho_factor(s)
-    except np.linalg.LinAlgError:
-        return -np.inf
-    k = sla.cho_solve(cs, h @ p).T  # P H' S^-1
-    logdet = 2.0 * np.sum(np.log(np.diag(cs[0])))
-    a_cl = f - f @ k @ h
-    b_cl = f @ k
-    total, count = 0.0, 0
-    for yr in records:
-        n = yr.shape[0]
-        burn = min(int(round(20.0 / dt)), n // 10)
-        if np.all(np.isfinite(yr)):
-            e = yr - _steady_state_predictions(a_cl, b_cl, yr) @ h.T
-            e = e[burn:]
-            quad = np.einsum("ij,ij->i", e, sla.cho_solve(cs, e.T).T)
-            total += -0.5 * float(np.sum(quad)) - 0.5 * (logdet + m * math.log(2 * math.pi)) * e.shape[0]
-            count += e.shape[0]
-        else:
-            x = np.zeros(f.shape[0])
-            pp = model["P0"] * alpha**2
-            for i in range(n):
-                live = np.isfinite(yr[i])
-                if live.any():
-                    hl = h[live]
-                    pht = pp @ hl.T
-                    sl = hl @ pht + np.diag(r[live])
-                    e = yr[i, live] - hl @ x
-                    try:
-                        c = sla.cho_factor(sl)
-                    except np.linalg.LinAlgError:
-                        return -np.inf
-                    if i >= burn:
-                        total += -0.5 * (float(e @ sla.cho_solve(c, e)) + 2.0 * np.sum(np.log(np.diag(c[0])))
-                                         + live.sum() * math.log(2 * math.pi))
-                        count += 1
-                    kk = sla.cho_solve(c, pht.T).T
-                    x = x + kk @ e
-                    pp = pp - kk @ pht.T
-                x = f @ x
-                pp = f @ pp @ f.T + q
-    return total / max(count, 1)
+def _inv_chol(s: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """``(U^-1, log det S)`` with ``S = U'U`` (so ``S^-1 = U^-1 U^-T``), or None if S is not positive definite.
+    (LAPACK potrf and trtri: much cheaper for these small matrices than a general or a Cholesky solve.)"""
+    u, info = _dpotrf(s, lower=0, clean=1)
+    if info != 0:
+        return None
+    ui, info = _dtrtri(u, lower=0)
+    if info != 0:
+        return None
+    return ui, 2.0 * float(np.log(u.diagonal()).sum())
 
 
-def _steady_state_predictions(a_cl: np.ndarray, b_cl: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Prior state means of a steady-state filter ``x[k+1] = a_cl x[k] + b_cl y[k]``, ``x[0] = 0`` (n_samples, n).
+def _conditioned_pieces(segments: list[np.ndarray], leads: list[int], max_len: int, f: np.ndarray, q: np.ndarray,
+                        h: np.ndarray, r: np.ndarray) -> tuple[dict, np.ndarray] | None:
+    """The training pieces and their common prior covariance, conditioned on what came before them through the
+    steady-state filter of the model (F, Q, H, r).
 
-    Decoupled into first-order modal recursions run by ``lfilter`` when ``a_cl`` is well diagonalisable;
-    otherwise a plain loop.
+    Each segment after its first ``lead`` samples is cut into pieces of at most ``max_len`` samples, of equal
+    length within the segment (its last ``< n_pieces`` samples are dropped). A piece starts from the
+    steady-state filter's prediction (run from the start of its segment) with the steady-state prior covariance,
+    so that for this model the pieces' likelihoods add up to the steady-state filter's over the segment after the
+    lead. Returns ({length: (data (length, n_out, n_pieces), initial means (n_states, n_pieces))}, covariance,
+    that log-likelihood per sample), or None if the model has no steady-state filter.
     """
-    n_s, n = y.shape[0], a_cl.shape[0]
-    lam, vec = np.linalg.eig(a_cl)
-    if np.linalg.cond(vec) < 1e6:
-        w = np.linalg.solve(vec, b_cl @ y.T)
-        xi = np.empty_like(w)
-        for i in range(n):
-            xi[i] = lfilter([0.0, 1.0], [1.0, -lam[i]], w[i])
-        return np.ascontiguousarray((vec @ xi).real.T)
-    xs = np.empty((n_s, n))
-    x = np.zeros(n)
-    for i in range(n_s):
-        xs[i] = x
-        x = a_cl @ x + b_cl @ y[i]
-    return xs
+    try:
+        pp = sla.solve_discrete_are(f.T, h.T, q, np.diag(r))
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    if not np.all(np.isfinite(pp)):
+        return None
+    pp = 0.5 * (pp + pp.T)
+    chol = _inv_chol(h @ pp @ h.T + np.diag(r))
+    if chol is None:
+        return None
+    ui, logdet = chol
+    fk = f @ (pp @ h.T @ ui @ ui.T)  # F K
+    a_cl = f - fk @ h
+    by_len: dict[int, tuple[list, list]] = {}
+    quad, count = 0.0, 0
+    for seg, lead in zip(segments, leads, strict=True):
+        u = np.zeros((seg.shape[1], seg.shape[0]))
+        u[:, 1:] = seg[:-1].T  # the prediction of sample k uses the samples before k
+        zp = _first_order_modes(a_cl, fk, u)  # (n_states, n_samples)
+        n_pieces = -(-(seg.shape[0] - lead) // max_len)
+        n = (seg.shape[0] - lead) // n_pieces
+        used = slice(lead, lead + n_pieces * n)
+        we = (seg[used] - (h @ zp[:, used]).T) @ ui  # whitened innovations
+        quad += float(np.einsum("ij,ij->", we, we))
+        count += we.shape[0]
+        for i in range(n_pieces):
+            k0 = lead + i * n
+            ys, zs = by_len.setdefault(n, ([], []))
+            ys.append(seg[k0:k0 + n])
+            zs.append(zp[:, k0])
+    ll = -0.5 * (quad / count + logdet + h.shape[0] * math.log(2.0 * math.pi))
+    groups = {n: (np.stack(ys, axis=2), np.stack(zs, axis=1)) for n, (ys, zs) in by_len.items()}
+    return groups, pp, (ll if math.isfinite(ll) else -math.inf)
+
+
+def _first_order_modes(a: np.ndarray, b: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """States ``x[k] = a x[k-1] + b u[:, k]``, ``x[-1] = 0``, shape (n_states, n_samples).
+
+    Run as decoupled first-order modal recursions (``lfilter``) when ``a`` is well diagonalisable, otherwise as a
+    plain loop.
+    """
+    lam, vec = np.linalg.eig(a)
+    if np.linalg.cond(vec) < 1e8:
+        # a is real: conjugate modes have conjugate states, so filter one of each pair and take twice its real part
+        keep = lam.imag >= 0
+        weight = np.where(lam.imag[keep] > 0, 2.0, 1.0)
+        w = (np.linalg.inv(vec)[keep] @ b) @ u
+        for i, lam_i in enumerate(lam[keep]):
+            w[i] = lfilter([1.0], [1.0, -lam_i], w[i])
+        return np.ascontiguousarray((vec[:, keep] * weight @ w).real)
+    drive = b @ u
+    out = np.empty_like(drive)
+    x = np.zeros(a.shape[0])
+    for k in range(drive.shape[1]):
+        x = a @ x + drive[:, k]
+        out[:, k] = x
+    return out

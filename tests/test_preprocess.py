@@ -1,14 +1,17 @@
 """Band-pass + z-score preprocessing: frequency response, statistics, causal streaming == causal batch, errors."""
 
 import doctest
+import importlib
 
 import numpy as np
 import pytest
 from scipy import signal
 
-import estimators.preprocess as pp
 from estimators.preprocess import Preprocessor, band_sos, preprocess
 from estimators.validation import NotFittedError
+
+# the package exports the function `preprocess`, which shadows the submodule's attribute name
+pp = importlib.import_module("estimators.preprocess")
 
 FS = 80.0
 
