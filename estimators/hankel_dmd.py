@@ -45,7 +45,8 @@ from .validation import (
     check_fitted,
     check_int,
     check_number,
-    constant_channels,
+    constant_channels_across,
+    split_at_nonfinite,
 )
 
 __all__ = ["HankelDMD", "harmonic_candidates", "svht_omega", "svht_rank"]
@@ -412,19 +413,7 @@ class HankelDMD:
         records = as_records(Y, "Y", allow_nan=split, min_samples=1)
         dropped = 0
         if split:
-            pieces = []
-            for rec in records:
-                bad = ~np.isfinite(rec).all(axis=1)
-                if not bad.any():
-                    pieces.append(rec)
-                    continue
-                edges = np.flatnonzero(np.diff(np.r_[True, bad, True].astype(np.int8)))
-                for start, stop in zip(edges[::2], edges[1::2], strict=True):
-                    if stop - start >= d + 2:
-                        pieces.append(rec[start:stop])
-                    else:
-                        dropped += stop - start
-                dropped += int(bad.sum())
+            pieces, dropped = split_at_nonfinite(records, d + 2)
             if not pieces:
                 raise ValueError(
                     f"Y has no finite stretch of at least delays + 2 = {d + 2} samples (missing='split' dropped all)"
@@ -437,9 +426,7 @@ class HankelDMD:
                     f"{name} has {rec.shape[0]} samples; delays = {d} needs at least delays + 2 = {d + 2} "
                     "(one delay window plus two snapshots)"
                 )
-        lo = np.min([r.min(axis=0) for r in records], axis=0)
-        hi = np.max([r.max(axis=0) for r in records], axis=0)
-        const = constant_channels(np.vstack([lo, hi]))
+        const = constant_channels_across(records)
         if const.size:
             raise ValueError(
                 f"Y has constant channel(s) {const.tolist()}: they carry no dynamics and make the Hankel matrix "

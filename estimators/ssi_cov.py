@@ -38,7 +38,14 @@ import scipy.fft as sfft
 import scipy.linalg as sla
 from scipy.cluster.hierarchy import fcluster, linkage
 
-from .validation import as_records, check_fitted, check_int, check_number, constant_channels
+from .validation import (
+    as_records,
+    check_fitted,
+    check_int,
+    check_number,
+    constant_channels_across,
+    split_at_nonfinite,
+)
 
 __all__ = ["SSICov", "correlation_sums"]
 
@@ -395,19 +402,7 @@ class SSICov:
         need = step * (2 * i - 1) + 1  # the largest lag plus one
         dropped = 0
         if split:
-            pieces = []
-            for rec in records:
-                bad = ~np.isfinite(rec).all(axis=1)
-                if not bad.any():
-                    pieces.append(rec)
-                    continue
-                edges = np.flatnonzero(np.diff(np.r_[True, bad, True].astype(np.int8)))
-                for start, stop in zip(edges[::2], edges[1::2], strict=True):
-                    if stop - start >= need:
-                        pieces.append(rec[start:stop])
-                    else:
-                        dropped += stop - start
-                dropped += int(bad.sum())
+            pieces, dropped = split_at_nonfinite(records, need)
             if not pieces:
                 raise ValueError(
                     f"Y has no finite stretch of at least {need} samples (lag_step * (2 block_rows - 1) + 1; "
@@ -422,9 +417,7 @@ class SSICov:
                     f"least lag_step * (2 block_rows - 1) + 1 = {need} (the largest lag plus one), and many times "
                     "more for usable correlation estimates"
                 )
-        lo = np.min([r.min(axis=0) for r in records], axis=0)
-        hi = np.max([r.max(axis=0) for r in records], axis=0)
-        const = constant_channels(np.vstack([lo, hi]))
+        const = constant_channels_across(records)
         if const.size:
             raise ValueError(
                 f"Y has constant channel(s) {const.tolist()}: they carry no dynamics and make the correlation "

@@ -20,8 +20,10 @@ __all__ = [
     "check_no_constant_channels",
     "check_number",
     "constant_channels",
+    "constant_channels_across",
     "describe_nonfinite",
     "is_record_list",
+    "split_at_nonfinite",
 ]
 
 _MAX_LISTED = 5
@@ -209,6 +211,46 @@ def constant_channels(Y: np.ndarray, *, rtol: float = 1e-12) -> np.ndarray:
         scale = np.maximum(np.abs(hi), np.abs(lo))
         const = none | ((hi - lo) <= rtol * scale)
     return np.flatnonzero(const)
+
+
+def constant_channels_across(records: Sequence[np.ndarray], *, rtol: float = 1e-12) -> np.ndarray:
+    """Channels that are constant over every record of a list (pooled min/max), as :func:`constant_channels`."""
+    lo = np.min([r.min(axis=0) for r in records], axis=0)
+    hi = np.max([r.max(axis=0) for r in records], axis=0)
+    return constant_channels(np.vstack([lo, hi]), rtol=rtol)
+
+
+def split_at_nonfinite(records: Sequence[np.ndarray], min_length: int) -> tuple[list[np.ndarray], int]:
+    """Cut records at every sample holding a NaN/inf and keep the finite stretches of at least ``min_length``.
+
+    Parameters
+    ----------
+    records : sequence of ndarray (n_samples, n_channels)
+    min_length : int
+        Shortest stretch kept (samples).
+
+    Returns
+    -------
+    pieces : list of ndarray
+        The finite stretches, in order (may be empty).
+    dropped : int
+        Samples not kept: the non-finite ones and those of stretches shorter than ``min_length``.
+    """
+    pieces: list[np.ndarray] = []
+    dropped = 0
+    for rec in records:
+        bad = ~np.isfinite(rec).all(axis=1)
+        if not bad.any():
+            pieces.append(rec)
+            continue
+        edges = np.flatnonzero(np.diff(np.r_[True, bad, True].astype(np.int8)))
+        for start, stop in zip(edges[::2], edges[1::2], strict=True):
+            if stop - start >= min_length:
+                pieces.append(rec[start:stop])
+            else:
+                dropped += stop - start
+        dropped += int(bad.sum())
+    return pieces, dropped
 
 
 def check_no_constant_channels(Y: np.ndarray, name: str = "Y", *, rtol: float = 1e-12) -> None:
