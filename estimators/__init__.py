@@ -5,12 +5,16 @@ Never imports :mod:`surrogates` or Gymnasium: the same code runs on surrogate, O
 * preprocessing -- :func:`preprocess`, :class:`Preprocessor` (band-pass + z-score, zero-phase or causal streaming);
 * identification -- :class:`HankelDMD`, :class:`SSICov`, :func:`mac`, :func:`pair_modes`,
   :func:`probabilistic_mode_shapes`, :func:`harmonic_candidates`, :func:`lyapunov_exponent` (Rosenstein);
-* virtual sensors -- :class:`HoldLastValue` (floor baseline);
+* virtual sensors -- :class:`HankelDMDSensor` (causal rolling-horizon Hankel-DMD), :class:`KalmanSensor`
+  (augmented Kalman filter on a linear model), :class:`HoldLastValue` (floor baseline);
+* scores -- :func:`r2_score`, :func:`nrmse`, :func:`reconstruction_scores` (the seed paper's definitions);
 * errors -- :class:`NotFittedError` (a ``ValueError``).
 """
 
 from .baseline import HoldLastValue
+from .dmd_sensor import HankelDMDSensor
 from .hankel_dmd import HankelDMD, harmonic_candidates, svht_omega, svht_rank
+from .kalman import KalmanSensor
 from .lyapunov import (
     LyapunovResult,
     delay_embedding_lag,
@@ -19,6 +23,7 @@ from .lyapunov import (
     lyapunov_exponent,
     lyapunov_time,
 )
+from .metrics import nrmse, r2_score, reconstruction_scores
 from .modal import ModeShapeDistribution, mac, pair_modes, probabilistic_mode_shapes, real_mode_shape
 from .preprocess import Preprocessor, band_sos, preprocess
 from .ssi_cov import SSICov, correlation_sums
@@ -26,7 +31,9 @@ from .validation import NotFittedError
 
 __all__ = [
     "HankelDMD",
+    "HankelDMDSensor",
     "HoldLastValue",
+    "KalmanSensor",
     "LyapunovResult",
     "ModeShapeDistribution",
     "NotFittedError",
@@ -41,10 +48,13 @@ __all__ = [
     "lyapunov_exponent",
     "lyapunov_time",
     "mac",
+    "nrmse",
     "pair_modes",
     "preprocess",
     "probabilistic_mode_shapes",
+    "r2_score",
     "real_mode_shape",
+    "reconstruction_scores",
     "svht_omega",
     "svht_rank",
 ]

@@ -317,6 +317,9 @@ class HankelDMD:
         Rank used.
     reduced_operator_ : ndarray (r, r)
         ``A~`` in the basis of the leading left singular vectors.
+    basis_ : ndarray (p d, r)
+        Those leading left singular vectors ``U`` (orthonormal columns): ``h ~ U a`` for a Hankel column ``h``, and
+        ``a[k+1] ~ A~ a[k]`` is the real linear (Koopman) model that :attr:`eigenvalues_` diagonalise.
     dt_ : float
     delays_ : int
     method_ : str
@@ -595,6 +598,7 @@ class HankelDMD:
         self.rank_ = r
         self.singular_values_ = s_all
         self.reduced_operator_ = Atilde
+        self.basis_ = U
         self.eigenvalues_ = mu
         with np.errstate(divide="ignore", invalid="ignore"):
             lam = np.log(mu) / self.dt_

@@ -1,0 +1,230 @@
+"""HankelDMDSensor: the causal rolling-horizon Hankel-DMD virtual sensor."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from estimators import NotFittedError
+from estimators.dmd_sensor import HankelDMDSensor
+from estimators.metrics import r2_score
+
+DT = 0.0125
+
+
+def modal_record(n: int, seed: int, noise: float = 0.0) -> np.ndarray:
+    """Three channels driven by two steady sinusoids (0.5 and 1.7 Hz): an exactly rank-4 delay embedding."""
+    t = np.arange(n) * DT
+    rng = np.random.default_rng(seed)
+    ph = rng.uniform(0, 2 * np.pi, 2)
+    q = np.c_[np.sin(2 * np.pi * 0.5 * t + ph[0]), 0.6 * np.sin(2 * np.pi * 1.7 * t + ph[1])]
+    Y = q @ np.array([[1.0, 0.5, -0.3], [0.2, -1.0, 0.8]]) + np.array([3.0, -1.0, 10.0])
+    return Y + noise * rng.standard_normal(Y.shape)
+
+
+def test_hidden_channel_of_an_exact_modal_system_is_recovered():
+    """Two modes, three channels: the lost channel follows from the other two (closed form: the mode shapes)."""
+    # 100 s: whole periods of both lines, so the training mean is the true offset
+    sensor = HankelDMDSensor(delays=40, rank=4, update_interval=1.0, dt=DT).fit(modal_record(8000, 0))
+    np.testing.assert_allclose(np.abs(sensor.dmd_.frequencies_hz_), [0.5, 0.5, 1.7, 1.7], rtol=1e-6)
+    Y = modal_record(4000, 1)  # another phase: not a training window
+    mask = np.array([True, True, False])
+    est = sensor.reconstruct(np.where(mask, Y, np.nan), mask)
+    settled = slice(80, None)  # the first calibration has seen one sample only
+    np.testing.assert_allclose(est[settled], Y[settled], atol=1e-4 * np.ptp(Y[:, 2]))
+
+
+def test_streaming_equals_reconstruct_and_is_causal():
+    rng = np.random.default_rng(3)
+    sensor = HankelDMDSensor(delays=30, rank=8, update_interval=0.3, dt=DT).fit(modal_record(5000, 0, noise=0.05))
+    Y = modal_record(1500, 2, noise=0.05)
+    mask = rng.random(Y.shape) < 0.7
+    batch = sensor.reconstruct(np.where(mask, Y, np.nan), mask)
+    sensor.reset()
+    stream = np.array([sensor.update(y, m) for y, m in zip(np.where(mask, Y, np.nan), mask, strict=True)])
+    np.testing.assert_allclose(stream, batch, rtol=0, atol=1e-9 * np.abs(batch).max())
+    k = 700
+    Y2 = Y.copy()
+    Y2[k + 1 :] = rng.standard_normal(Y2[k + 1 :].shape) * 50.0
+    later = sensor.reconstruct(np.where(mask, Y2, np.nan), mask)
+    np.testing.assert_allclose(later[: k + 1], batch[: k + 1], rtol=0, atol=1e-9)
+    assert not np.allclose(later[k + 1 :], batch[k + 1 :])
+
+
+def test_lookahead_smoother_is_offline_only_and_uses_the_future():
+    sensor = HankelDMDSensor(delays=30, rank=8, dt=DT, causal=False).fit(modal_record(5000, 0, noise=0.05))
+    Y = modal_record(800, 2, noise=0.05)
+    mask = np.array([True, False, True])
+    est = sensor.reconstruct(Y, mask)
+    Y2 = Y.copy()
+    Y2[401:] *= -1.0  # samples after k = 400 (a calibration instant) change the estimate at k: not causal
+    assert not np.allclose(sensor.reconstruct(Y2, mask)[400], est[400])
+    with pytest.raises(ValueError, match="look-ahead"):
+        sensor.update(Y[0], mask)
+
+
+def test_a_constant_mask_costs_one_factorisation():
+    sensor = HankelDMDSensor(delays=30, rank=8, update_interval=0.1, dt=DT).fit(modal_record(5000, 0, noise=0.05))
+    Y = modal_record(4000, 4, noise=0.05)
+    sensor.reconstruct(Y, np.array([True, False, True]))
+    # the window fills up over the first calibrations (each a new pattern), then one pattern for the rest
+    assert sensor.cache_info_["misses"] <= 30 // 8 + 2
+    assert sensor.cache_info_["hits"] >= sensor.n_calibrations_ - 5
+
+
+def test_bad_input_gives_clear_errors():
+    with pytest.raises(NotFittedError):
+        HankelDMDSensor().update(np.zeros(3), np.ones(3, dtype=bool))
+    sensor = HankelDMDSensor(delays=30, rank=8, dt=DT).fit(modal_record(3000, 0, noise=0.05))
+    with pytest.raises(ValueError, match=r"y must have shape \(3,\)"):
+        sensor.update(np.zeros(4), np.ones(4, dtype=bool))
+    with pytest.raises(ValueError, match="mask must have shape"):
+        sensor.update(np.zeros(3), np.ones(2, dtype=bool))
+    with pytest.raises(ValueError, match="channels"):
+        sensor.reconstruct(np.zeros((100, 4)))
+    with pytest.raises(ValueError, match="update_interval"):
+        HankelDMDSensor(update_interval=0.0, dt=DT).fit(modal_record(3000, 0))
+    with pytest.raises(ValueError, match="constant"):
+        Y = modal_record(3000, 0)
+        Y[:, 1] = 2.0
+        HankelDMDSensor(delays=30, rank=8, dt=DT).fit(Y)
+    with pytest.raises(ValueError, match="ridge = 0"):
+        s = HankelDMDSensor(delays=30, rank=8, dt=DT, ridge=0.0).fit(modal_record(3000, 0, noise=0.05))
+        s.reset()
+        s.update(np.zeros(3), np.ones(3, dtype=bool))
+
+
+# ------------------------------------------------------------------------------ the surrogate (OC3 spar, FA)
+SCENARIOS = {"A": (5, (2, 3, 5, 7, 11, 12, 14, 16)), "B": (7, (0, 8, 9, 17)), "C": (2, (0, 8, 9, 17))}
+PAPER_TRAIN = (1, 3, 4, 6, 8, 9, 10, 11, 12)
+
+
+def scenario_r2(surrogates, model, sensor, name: str, duration: float, seed: int = 7) -> np.ndarray:
+    case, hidden = SCENARIOS[name]
+    noisy, truth = surrogates.simulate(model, case, duration=duration, seed=seed, return_truth=True)
+    y, t = noisy.planar("FA").y, truth.planar("FA").y
+    mask = np.ones(18, dtype=bool)
+    mask[list(hidden)] = False
+    return r2_score(t, sensor.reconstruct(np.where(mask, y, np.nan), mask))[list(hidden)]
+
+
+@pytest.fixture(scope="module")
+def spar():
+    surrogates = pytest.importorskip("surrogates")
+    model = surrogates.FOWTModel()
+    train = [surrogates.simulate(model, c, duration=120.0, seed=100 + c).planar("FA").y for c in (1, 6, 11)]
+    sensor = HankelDMDSensor(update_interval=1.0, dt=DT).fit(train)
+    noisy, truth = surrogates.simulate(model, 7, duration=60.0, seed=21, return_truth=True)
+    return surrogates, model, sensor, noisy.planar("FA").y, truth.planar("FA").y
+
+
+def test_paper_scenarios_on_short_surrogate_data(spar):
+    """Trained on 3 OLCs x 2 min, tested on unseen OLCs/seeds with 1 s updates: the issue's R2 targets."""
+    surrogates, model, sensor, _, _ = spar
+    for name in "ABC":
+        r2 = scenario_r2(surrogates, model, sensor, name, duration=120.0)
+        print(f"\nDMD sensor, scenario {name}: hidden R2 {np.round(r2, 4)}")
+        assert np.median(r2) >= 0.95 and r2.min() >= 0.85
+
+
+def test_accuracy_falls_with_the_update_interval(spar):
+    """Between calibrations the sensor only predicts: beyond the response's predictability horizon (~1.5 s,
+    README) the hidden channels degrade, and calibrating every sample is nearly exact."""
+    _, _, sensor, y, truth = spar
+    mask = np.ones(18, dtype=bool)
+    mask[[0, 8, 9, 17]] = False
+    scores = {}
+    for interval in (DT, 0.25, 1.0, 4.0):
+        s = HankelDMDSensor(update_interval=interval, dt=DT)
+        s.__dict__.update({k: v for k, v in sensor.__dict__.items() if k.endswith("_") or k.startswith("_")})
+        s.update_samples_ = max(1, round(interval / DT))
+        scores[interval] = np.median(r2_score(truth, s.reconstruct(np.where(mask, y, np.nan), mask))[~mask])
+    print(f"\nmedian hidden R2 vs update interval: {scores}")
+    assert scores[DT] > 0.995
+    assert scores[DT] >= scores[0.25] >= scores[1.0] >= scores[4.0]
+    assert scores[4.0] < scores[0.25] - 0.01
+
+
+def hidden_b_mask(n: int) -> np.ndarray:
+    mask = np.ones((n, 18), dtype=bool)
+    mask[:, [0, 8, 9, 17]] = False
+    return mask
+
+
+def test_nan_in_live_channels_is_a_dropout(spar):
+    _, _, sensor, y, truth = spar
+    rng = np.random.default_rng(5)
+    mask = hidden_b_mask(y.shape[0])
+    holes = (rng.random(y.shape) < 0.05) & mask
+    est_nan = sensor.reconstruct(np.where(holes, np.nan, y), mask)
+    est_masked = sensor.reconstruct(y, mask & ~holes)
+    assert np.all(np.isfinite(est_nan))
+    np.testing.assert_array_equal(est_nan, est_masked)
+    assert r2_score(truth, est_nan)[[0, 8, 9, 17]].min() > 0.9
+
+
+def test_total_blackout_runs_open_loop_and_recovers(spar):
+    _, _, sensor, y, truth = spar
+    mask = hidden_b_mask(y.shape[0])
+    uninterrupted = sensor.reconstruct(y, mask)
+    k0, k1 = 1600, 1600 + 240  # 3 s at 80 Hz from t = 20 s: the delay window (0.75 s) empties during it
+    mask[k0:k1] = False
+    est = sensor.reconstruct(y, mask)
+    assert np.all(np.isfinite(est))
+    # open loop from the first calibration whose window is empty to the first one that sees data again
+    first_empty = -(-(k0 + sensor.delays_ - 1) // sensor.update_samples_) * sensor.update_samples_
+    back = -(-k1 // sensor.update_samples_) * sensor.update_samples_
+    assert sensor.n_open_loop_ == back - first_empty
+    assert np.all(np.abs(est[k0:k1] - sensor.mean_) < 10 * sensor.scale_)  # the prediction does not diverge
+    after = slice(k1 + 400, None)  # 5 s after the sensors return: as good as without the blackout
+    assert np.all(r2_score(truth[after], est[after]) > r2_score(truth[after], uninterrupted[after]) - 0.01)
+
+
+def test_mask_changing_every_sample(spar):
+    _, _, sensor, y, truth = spar
+    rng = np.random.default_rng(6)
+    mask = rng.random(y.shape) < 0.6
+    est = sensor.reconstruct(y, mask)
+    assert np.all(np.isfinite(est))
+    lost = ~mask
+    # score each channel on the samples where it was lost
+    r2 = np.array([r2_score(truth[lost[:, c], c], est[lost[:, c], c]) for c in range(18)])
+    print(f"\nmask changing every sample (40 % lost): R2 of lost samples {np.round(r2, 3)}")
+    assert np.median(r2) > 0.95 and r2.min() > 0.8
+
+
+def test_spikes_and_a_stuck_sensor_are_gated(spar):
+    _, _, sensor, y, truth = spar
+    mask = hidden_b_mask(y.shape[0])
+    hidden = [0, 8, 9, 17]
+    clean = r2_score(truth, sensor.reconstruct(y, mask))[hidden]
+    assert sensor.n_gated_ == 0  # nothing rejected on clean data
+    rng = np.random.default_rng(7)
+    spikes = (rng.random(y.shape) < 0.005) & mask
+    y_spiky = y + spikes * rng.choice([-1.0, 1.0], size=y.shape) * 30.0 * sensor.scale_
+    gated = r2_score(truth, sensor.reconstruct(y_spiky, mask))[hidden]
+    y_stuck = y.copy()
+    y_stuck[800:, 4] = y[800, 4]  # gauge-5 accelerometer frozen from t = 10 s, still reported available
+    stuck = r2_score(truth, sensor.reconstruct(y_stuck, mask))[hidden]
+    sensor.gate_sigma = None
+    try:
+        ungated = r2_score(truth, sensor.reconstruct(y_spiky, mask))[hidden]
+    finally:
+        sensor.gate_sigma = 8.0
+    print(f"\nDMD sensor: hidden R2 clean {np.round(clean, 4)}, spikes gated {np.round(gated, 4)}, ungated "
+          f"{np.round(ungated, 4)}, stuck sensor {np.round(stuck, 4)}")
+    assert np.all(gated > clean - 0.005) and np.all(stuck > clean - 0.01)
+    assert np.all(ungated < gated - 0.1)
+
+
+@pytest.mark.slow
+def test_paper_scenarios_on_surrogate_data():
+    """Train on the paper's OLCs 1, 3, 4, 6, 8-12 (300 s each), test scenarios A, B, C (600 s), 1 s updates."""
+    surrogates = pytest.importorskip("surrogates")
+    model = surrogates.FOWTModel()
+    train = [surrogates.simulate(model, c, duration=300.0, seed=100 + c).planar("FA").y for c in PAPER_TRAIN]
+    sensor = HankelDMDSensor(update_interval=1.0, dt=DT).fit(train)
+    for name in "ABC":
+        r2 = scenario_r2(surrogates, model, sensor, name, duration=600.0)
+        print(f"\nDMD sensor, scenario {name}: hidden R2 {np.round(r2, 4)} (median {np.median(r2):.4f})")
+        assert np.median(r2) >= 0.95 and r2.min() >= 0.85
