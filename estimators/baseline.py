@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .validation import as_records
+
 __all__ = ["HoldLastValue"]
 
 
@@ -38,12 +40,29 @@ class HoldLastValue:
     def __init__(self, fill: str = "zero") -> None:
         self.fill = fill
 
-    def fit(self, Y: np.ndarray, mask: np.ndarray | None = None) -> HoldLastValue:
-        """Learn the per-channel mean of the available training data (for ``fill="mean"``)."""
-        Y = np.asarray(Y, dtype=float)
-        if Y.ndim != 2:
-            raise ValueError(f"Y must be 2-D (n_samples, n_channels), got shape {Y.shape}")
-        m = np.isfinite(Y) if mask is None else (np.asarray(mask, dtype=bool) & np.isfinite(Y))
+    def fit(self, Y: object, mask: object = None) -> HoldLastValue:
+        """Learn the per-channel mean of the available training data (for ``fill="mean"``).
+
+        Parameters
+        ----------
+        Y : array_like (n_samples, n_channels) or list of such records
+            Training data (channel units); NaN marks missing samples.
+        mask : array_like of bool, shape of ``Y`` (a list like ``Y`` for a list), optional
+            False marks further missing samples.
+
+        Returns
+        -------
+        self
+        """
+        records = as_records(Y, "Y", allow_nan=True, min_samples=1)
+        if mask is None:
+            masks = [np.ones(r.shape, dtype=bool) for r in records]
+        else:
+            masks = [np.asarray(m, dtype=bool) for m in (mask if isinstance(mask, (list, tuple)) else [mask])]
+            if len(masks) != len(records) or any(m.shape != r.shape for m, r in zip(masks, records, strict=True)):
+                raise ValueError("mask must have the shape of Y (a list of the same shapes for a list of records)")
+        Y = np.concatenate(records, axis=0)
+        m = np.concatenate(masks, axis=0) & np.isfinite(Y)
         counts = m.sum(axis=0)
         self.mean_ = np.where(counts > 0, np.where(m, Y, 0.0).sum(axis=0) / np.maximum(counts, 1), 0.0)
         self.n_channels_ = Y.shape[1]
