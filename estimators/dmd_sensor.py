@@ -34,6 +34,7 @@ from __future__ import annotations
 from collections import OrderedDict
 
 import numpy as np
+import scipy.linalg as sla
 
 from .hankel_dmd import HankelDMD
 from .validation import as_2d_float, as_records, check_fitted, check_number
@@ -198,8 +199,10 @@ class HankelDMDSensor:
         self._phi_first = np.ascontiguousarray(Phi[:p])
         self.residual_std_ = self._training_residual(Z, d)
         self._rstd_rows = np.tile(np.maximum(self.residual_std_, _MIN_RESIDUAL), d)
-        self._lambda = ridge * float(np.real(np.einsum("ij,ij->", Phi.conj(), Phi))) / Phi.shape[1]
-        self._cache: OrderedDict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = OrderedDict()
+        lam = ridge * float(np.real(np.einsum("ij,ij->", Phi.conj(), Phi))) / Phi.shape[1]
+        self._lambda = lam
+        self._psi, self._conv, self._ridge_c = _real_basis(Phi, mu, lam)
+        self._cache: OrderedDict[bytes, tuple[np.ndarray, tuple]] = OrderedDict()
         self._hits = self._misses = 0
         self.reset()
         return self
@@ -259,8 +262,8 @@ class HankelDMDSensor:
             live = m.astype(bool) & np.isfinite(y)
         return y, live
 
-    def _solver(self, live_rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(rows, K, Kp) for a window pattern: ``b = K h[rows] + Kp b_pred``; cached by pattern."""
+    def _solver(self, live_rows: np.ndarray) -> tuple[np.ndarray, tuple]:
+        """(rows, Cholesky factor of ``Psi_S^T Psi_S + D``) for a window pattern; cached by pattern."""
         key = np.packbits(live_rows).tobytes()
         hit = self._cache.get(key)
         if hit is not None:
@@ -269,23 +272,22 @@ class HankelDMDSensor:
             return hit
         self._misses += 1
         rows = np.flatnonzero(live_rows)
-        A = self._phi[rows]
-        r = A.shape[1]
-        G = A.conj().T @ A
-        G[np.diag_indices(r)] += self._lambda
+        A = self._psi[rows]
+        G = A.T @ A
+        G[np.diag_indices_from(G)] += self._ridge_c
         try:
-            c = np.linalg.cholesky(G)
-            inv = np.linalg.inv(c)
-            Ginv = inv.conj().T @ inv
-        except np.linalg.LinAlgError:  # pragma: no cover - G is Hermitian positive definite for lambda > 0
-            Ginv = np.linalg.pinv(G)
-        K = Ginv @ A.conj().T
-        Kp = self._lambda * Ginv
-        entry = (rows, K, Kp)
+            cho = sla.cho_factor(G, lower=True, check_finite=False)
+        except np.linalg.LinAlgError:  # pragma: no cover - positive definite for ridge > 0
+            cho = sla.cho_factor(G + np.eye(G.shape[0]) * 1e-12 * np.trace(G), lower=True, check_finite=False)
+        entry = (rows, cho)
         self._cache[key] = entry
         if len(self._cache) > _CACHE_SIZE:
             self._cache.popitem(last=False)
         return entry
+
+    def _solve(self, flat: np.ndarray, h_all: np.ndarray, c_pred: np.ndarray) -> np.ndarray:
+        rows, cho = self._solver(flat)
+        return sla.cho_solve(cho, self._psi[rows].T @ h_all[rows] + self._ridge_c * c_pred, check_finite=False)
 
     def _calibrate(self, window: np.ndarray, live: np.ndarray, b_pred: np.ndarray) -> tuple[np.ndarray, bool]:
         """Amplitudes fitted to a window (d, p) with its live flags; (b, open_loop)."""
@@ -309,17 +311,17 @@ class HankelDMDSensor:
                 flat = live.reshape(-1)
                 if not flat.any():
                     return b_pred, True
-        rows, K, Kp = self._solver(flat)
-        b = K @ h_all[rows] + Kp @ b_pred
+        c_pred = _b_to_c(b_pred, self._conv)
+        c = self._solve(flat, h_all, c_pred)
         if self.gate_sigma is not None:
             # trimmed least squares: refit on the entries the current fit explains, re-admitting any that the
             # new fit explains again, until the set is stable
             live_rows = np.flatnonzero(flat)
-            phi_live, h_live, rstd_live = self._phi[live_rows], h_all[live_rows], self._rstd_rows[live_rows]
+            psi_live, h_live, rstd_live = self._psi[live_rows], h_all[live_rows], self._rstd_rows[live_rows]
             keep = np.ones(live_rows.size, dtype=bool)
-            b_all = b
+            c_all = c
             for _ in range(_GATE_ITERATIONS):
-                ok = np.abs((phi_live @ b).real - h_live) <= self.gate_sigma * rstd_live
+                ok = np.abs(psi_live @ c - h_live) <= self.gate_sigma * rstd_live
                 if np.array_equal(ok, keep):
                     break
                 keep = ok
@@ -327,12 +329,12 @@ class HankelDMDSensor:
                     break
                 sel = np.zeros_like(flat)
                 sel[live_rows[keep]] = True
-                rows, K, Kp = self._solver(sel)
-                b = K @ h_all[rows] + Kp @ b_pred
+                c = self._solve(sel, h_all, c_pred)
             if keep.sum() < 0.5 * keep.size:  # the gate never removes most of the window: the model is off
                 keep[:] = True
-                b = b_all
+                c = c_all
             self.n_gated_ += int((~keep).sum())
+        b = _c_to_b(c, self._conv, self._mu.size)
         return b, False
 
     def update(self, y: object, mask: object = None) -> np.ndarray:
@@ -444,3 +446,53 @@ class HankelDMDSensor:
         self._open = open_
         return out * self.scale_ + self.mean_
 
+
+
+# ------------------------------------------------------------------------------------------- real basis
+def _real_basis(Phi: np.ndarray, mu: np.ndarray, lam: float) -> tuple[np.ndarray, tuple, np.ndarray]:
+    """Real basis ``Psi`` of the modes of real data, the index maps between ``b`` and ``c``, and the ridge.
+
+    A real signal has conjugate amplitudes on conjugate modes, so ``Phi b = Psi c`` with real ``c``: a real mode
+    contributes column ``Re(phi)`` with ``c = Re(b)``; a pair ``(phi, conj(phi))`` contributes ``Re(phi)`` and
+    ``-Im(phi)`` with ``c = 2 (Re(b), Im(b))``. The ridge ``lam |b - b_pred|^2`` becomes ``sum D (c - c_pred)^2``
+    with ``D = lam`` for a real mode and ``lam / 2`` for each column of a pair. Real arithmetic makes a new
+    window pattern four times cheaper to factorise.
+    """
+    r = mu.size
+    tol = 1e-9 * max(1.0, float(np.max(np.abs(mu))))
+    assigned = np.zeros(r, dtype=bool)
+    real_idx, first, second = [], [], []
+    for j in range(r):
+        if assigned[j]:
+            continue
+        assigned[j] = True
+        if abs(mu[j].imag) <= tol:
+            real_idx.append(j)
+            continue
+        cand = np.flatnonzero(~assigned)
+        k = int(cand[np.argmin(np.abs(mu[cand] - np.conj(mu[j])))]) if cand.size else -1
+        if k < 0 or abs(mu[k] - np.conj(mu[j])) > 1e-6 * max(1.0, abs(mu[j])):
+            raise ValueError("the DMD eigenvalues are not in conjugate pairs (complex training data?)")
+        assigned[k] = True
+        first.append(j if mu[j].imag > 0 else k)
+        second.append(k if mu[j].imag > 0 else j)
+    real_idx, first, second = (np.asarray(v, dtype=int) for v in (real_idx, first, second))
+    n_r, n_p = real_idx.size, first.size
+    psi = np.concatenate([Phi[:, real_idx].real, Phi[:, first].real, -Phi[:, first].imag], axis=1)
+    ridge = np.concatenate([np.full(n_r, lam), np.full(2 * n_p, lam / 2)])
+    return np.ascontiguousarray(psi), (real_idx, first, second), ridge
+
+
+def _b_to_c(b: np.ndarray, conv: tuple) -> np.ndarray:
+    real_idx, first, _ = conv
+    return np.concatenate([b[real_idx].real, 2.0 * b[first].real, 2.0 * b[first].imag])
+
+
+def _c_to_b(c: np.ndarray, conv: tuple, r: int) -> np.ndarray:
+    real_idx, first, second = conv
+    n_r, n_p = real_idx.size, first.size
+    b = np.empty(r, dtype=complex)
+    b[real_idx] = c[:n_r]
+    b[first] = 0.5 * (c[n_r : n_r + n_p] + 1j * c[n_r + n_p :])
+    b[second] = np.conj(b[first])
+    return b
