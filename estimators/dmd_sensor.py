@@ -60,7 +60,9 @@ class HankelDMDSensor:
         DMD truncation rank (see :class:`~estimators.hankel_dmd.HankelDMD`). Default 90, the seed paper's
         extended basis.
     update_interval : float
-        Time between calibrations (s); rounded to whole samples (at least one).
+        Time between calibrations (s); rounded to whole samples (at least one). May be changed after
+        :meth:`fit` (it takes effect at the next :meth:`reset`, which :meth:`reconstruct` calls): a sweep over
+        intervals needs one fit.
     dt : float
         Sample interval (s).
     causal : bool
@@ -78,6 +80,10 @@ class HankelDMDSensor:
         flat-lined (stuck) and left out as well. The gate never removes more than half of a window's live
         entries (then the model, not the data, is off, and the untrimmed fit is used), and its residual scale is
         at least 0.1 % of the channel's standard deviation. ``None`` switches the gate off.
+    passthrough : bool
+        Return live channels as measured (default) rather than as the model reconstructs them. The model's
+        value of a live channel jumps a little at each calibration; the measurement does not (but a spike or a
+        stuck value on a live channel then passes through: the gate protects only the lost channels).
     method : str
         Solver of the offline DMD (``"auto"``, ``"dense"``, ``"gram"``, ``"randomized"``).
 
@@ -92,7 +98,7 @@ class HankelDMDSensor:
     n_channels_ : int
     delays_ : int
     update_samples_ : int
-        Samples between calibrations.
+        Samples between calibrations (set by :meth:`reset`).
     n_open_loop_ : int
         Samples of the last stream estimated with no live data in the window (pure prediction).
     n_calibrations_ : int
@@ -128,6 +134,7 @@ class HankelDMDSensor:
         *,
         ridge: float = 1e-5,
         gate_sigma: float | None = 8.0,
+        passthrough: bool = True,
         method: str = "auto",
     ) -> None:
         self.delays = delays
@@ -137,6 +144,7 @@ class HankelDMDSensor:
         self.causal = causal
         self.ridge = ridge
         self.gate_sigma = gate_sigma
+        self.passthrough = passthrough
         self.method = method
 
     # ------------------------------------------------------------------------------------------------ fit
@@ -156,7 +164,7 @@ class HankelDMDSensor:
         self
         """
         dt = check_number("dt", self.dt, positive=True)
-        interval = check_number("update_interval", self.update_interval, positive=True)
+        check_number("update_interval", self.update_interval, positive=True)
         ridge = check_number("ridge", self.ridge, nonneg=True)
         if self.gate_sigma is not None:
             check_number("gate_sigma", self.gate_sigma, positive=True)
@@ -186,10 +194,10 @@ class HankelDMDSensor:
         dmd.fit(Z)
         d = dmd.delays_
         self.dmd_ = dmd
+        self.dt_ = dt
         self.mean_, self.scale_ = mean, scale
         self.n_channels_ = p
         self.delays_ = d
-        self.update_samples_ = max(1, int(round(interval / dt)))
         mu = dmd.eigenvalues_
         self._mu = mu
         self._mu_open = np.where(np.abs(mu) > 1.0, mu / np.abs(mu), mu)
@@ -228,6 +236,8 @@ class HankelDMDSensor:
     def reset(self) -> None:
         """Start a new stream: empty window, zero amplitudes (the estimate is the training mean until data)."""
         check_fitted(self, "dmd_")
+        interval = check_number("update_interval", self.update_interval, positive=True)
+        self.update_samples_ = max(1, int(round(interval / self.dt_)))
         d, p = self.delays_, self.n_channels_
         self._zbuf = np.zeros((d, p))
         self._live = np.zeros((d, p), dtype=bool)
@@ -372,7 +382,10 @@ class HankelDMDSensor:
         if self._open:
             self.n_open_loop_ += 1
         self._k += 1
-        return (self._phi_last @ self._b).real * self.scale_ + self.mean_
+        est = (self._phi_last @ self._b).real * self.scale_ + self.mean_
+        if self.passthrough:
+            est[live] = y[live]
+        return est
 
     # -------------------------------------------------------------------------------------------- batch
     def reconstruct(self, Y: object, mask: object = None) -> np.ndarray:
@@ -394,6 +407,7 @@ class HankelDMDSensor:
         ndarray (n_samples, n_channels)
         """
         check_fitted(self, "dmd_")
+        self.reset()
         p, d, nu = self.n_channels_, self.delays_, self.update_samples_
         Y = as_2d_float(Y, "Y", allow_nan=True, n_channels=p)
         if np.isinf(Y).any():
@@ -407,7 +421,6 @@ class HankelDMDSensor:
         n = Y.shape[0]
         Z = np.where(live, (np.where(live, Y, 0.0) - self.mean_) / self.scale_, 0.0)
         out = np.empty((n, p))
-        self.reset()
         b = self._b
         open_ = True
         n_open = 0
@@ -444,7 +457,10 @@ class HankelDMDSensor:
             self.n_calibrations_ += 1
         self.n_open_loop_ = n_open
         self._open = open_
-        return out * self.scale_ + self.mean_
+        out = out * self.scale_ + self.mean_
+        if self.passthrough:
+            out[live] = Y[live]
+        return out
 
 
 

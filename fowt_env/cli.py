@@ -281,6 +281,50 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from .compare import SCENARIO_NAMES, SWEEP_INTERVALS, CompareSettings, compare, parse_int_list
+
+    def floats(text: str, name: str) -> list[float]:
+        try:
+            return [float(v) for v in text.split(",")]
+        except ValueError:
+            raise ValueError(f"--{name}: expected comma-separated seconds, got {text!r}") from None
+
+    scenarios = list(SCENARIO_NAMES) if args.scenario == "all" else [s.strip() for s in args.scenario.split(",")]
+    intervals = list(SWEEP_INTERVALS) if args.update_interval == "sweep" else floats(args.update_interval,
+                                                                                      "update-interval")
+    options: dict[str, dict] = {}
+    for spec in args.option or []:
+        key, eq, value = spec.partition("=")
+        est, dot, param = key.partition(".")
+        if not (eq and dot and est and param):
+            raise ValueError(f"--option: expected ESTIMATOR.PARAM=VALUE, got {spec!r}")
+        try:
+            parsed = json.loads(value)
+        except json.JSONDecodeError:
+            parsed = value
+        options.setdefault(est, {})[param] = parsed
+    lyap = args.lyapunov_time if args.lyapunov_time in ("auto", "none") else floats(args.lyapunov_time,
+                                                                                    "lyapunov-time")[0]
+    settings = CompareSettings(
+        train_cases=tuple(parse_int_list(args.train_cases, "--train-cases")), train_duration=args.train_duration,
+        train_seed=args.train_seed, duration=args.duration, plane=None if args.plane == "all" else args.plane,
+        dropout_rate=args.dropout_rate, dropout_burst_s=args.dropout_burst, estimator_options=options)
+    res = compare(scenarios, [e.strip() for e in args.estimators.split(",")],
+                  cases=parse_int_list(args.cases, "--cases") if args.cases else None,
+                  seeds=parse_int_list(args.seeds, "--seeds"), update_intervals=intervals, settings=settings,
+                  lyapunov_time=None if lyap == "none" else lyap)
+    print(res.summary())
+    if args.json:
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.json).write_text(json.dumps(res.to_dict(), indent=1))
+        print(f"wrote {args.json}")
+    if args.plot:
+        for path in res.plot(args.plot):
+            print(f"wrote {path}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser (exposed for tests and docs)."""
     p = argparse.ArgumentParser(prog="fowt-env", description=__doc__.split("Examples")[0].strip(),
@@ -345,6 +389,44 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("--json", default=None, help="write modes and pairing as JSON")
     i.add_argument("--plot", default=None, help="folder for the figures")
     i.set_defaults(func=_cmd_identify)
+
+    c = sub.add_parser(
+        "compare", help="virtual sensing: score estimators on hidden channels of unseen load cases (R2, NRMSE)",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Train virtual sensors on some OLCs, hide channels of unseen OLCs/seeds (the seed paper's "
+                    "scenarios A, B, C or random dropouts), and report R2 and NRMSE per hidden channel (physical and "
+                    "band-passed), the 95 %% interval coverage and the cost per sample.",
+        epilog="Examples:\n"
+               "  fowt-env compare --duration 60                      # paper scenarios A, B, C; hold, kalman, dmd\n"
+               "  fowt-env compare --scenario B,random --estimators hold,kalman --seeds 0-2 --json cmp.json\n"
+               "  fowt-env compare --scenario A --estimators dmd,kalman --update-interval sweep --plot figs\n"
+               "  fowt-env compare --cases 2,5,7 --option dmd.rank=24 --option kalman.gate_sigma=null")
+    c.add_argument("--scenario", default="A,B,C", help="comma-separated A, B, C, random, or 'all' (default A,B,C)")
+    c.add_argument("--cases", default=None,
+                   help="test OLCs, e.g. 2,5,7 or 1-12, each under every scenario (default: the paper's pairing "
+                        "A->5, B->7, C->2; random->7)")
+    c.add_argument("--seeds", default="0", help="test seeds, e.g. 0,1,2 or 0-4 (default 0)")
+    c.add_argument("--duration", type=float, default=600.0, help="seconds per test record (default 600)")
+    c.add_argument("--estimators", default="hold,kalman,dmd",
+                   help="comma-separated names: hold, kalman, dmd, koopman (default hold,kalman,dmd)")
+    c.add_argument("--update-interval", default="1",
+                   help="recalibration interval(s) in s for sensors that use one (dmd): e.g. 1 or 0.5,1,2, or "
+                        "'sweep' = 0.25,0.5,1,2,4 (default 1, the paper's)")
+    c.add_argument("--train-cases", default="1,3,4,6,8-12", help="training OLCs (default the paper's 1,3,4,6,8-12)")
+    c.add_argument("--train-duration", type=float, default=300.0, help="seconds per training record (default 300)")
+    c.add_argument("--train-seed", type=int, default=1000,
+                   help="the training record of OLC c uses seed TRAIN_SEED + c (default 1000)")
+    c.add_argument("--plane", choices=["FA", "SS", "all"], default="FA",
+                   help="the 18 channels of one plane, or all 36 tower channels (default FA)")
+    c.add_argument("--dropout-rate", type=float, default=0.2, help="random scenario: lost fraction (default 0.2)")
+    c.add_argument("--dropout-burst", type=float, default=2.0, help="random scenario: mean burst in s (default 2)")
+    c.add_argument("--lyapunov-time", default="auto",
+                   help="seconds, 'auto' (Rosenstein on band-passed tower-top acceleration) or 'none'")
+    c.add_argument("--option", action="append", metavar="EST.PARAM=VALUE",
+                   help="repeatable estimator option (VALUE parsed as JSON if it can be), e.g. dmd.rank=24")
+    c.add_argument("--json", default=None, help="write the result as JSON (timings in its 'wall_clock' part)")
+    c.add_argument("--plot", default=None, help="folder for the figures")
+    c.set_defaults(func=_cmd_compare)
 
     m = sub.add_parser("modes", help="modal frequencies and damping of the linearised model")
     m.add_argument("--case", default=None, help="OLC number (default: parked, still water)")
