@@ -9,6 +9,7 @@ import control
 import numpy as np
 import pytest
 import scipy.linalg as sla
+from scipy.signal import lfilter
 
 import estimators.kalman
 from estimators.baseline import HoldLastValue
@@ -101,6 +102,61 @@ def test_hidden_output_beats_baseline_and_its_interval_is_calibrated(oscillator)
     # EM climbs the likelihood of the search: it starts at the best grid point's value and ends at the fitted one
     assert sensor.em_log_likelihood_[0] == pytest.approx(max(s["log_likelihood"] for s in sensor.search_), abs=1e-9)
     assert sensor.log_likelihood_ == max(sensor.em_log_likelihood_) > sensor.em_log_likelihood_[0]
+    # the model is right (white noise, linear system): the calibration leaves the intervals (nearly) alone
+    assert np.all(sensor.interval_scale_ >= 1.0) and np.all(sensor.interval_scale_ < 1.1)
+
+
+def coloured_noise(n: int, seed: int, std: np.ndarray, tau: float) -> np.ndarray:
+    """AR(1) noise per column (stationary std ``std``, correlation time ``tau``), started from zero."""
+    rng = np.random.default_rng(seed)
+    a = np.exp(-DT / tau)
+    return lfilter([1.0], [1.0, -a], rng.standard_normal((n, std.size)) * std * np.sqrt(1.0 - a * a), axis=0)
+
+
+def test_calibration_widens_the_intervals_of_unmeasured_channels_only(oscillator):
+    _, y_train, y_test, _, _ = oscillator
+    sys = two_dof_system()
+    col = np.array([0.004, 0.004, 0.1, 0.1])  # slow sensor errors the white-noise model does not know about
+    y_col = y_train + coloured_noise(y_train.shape[0], 11, col, tau=2.0)
+    calibrated = KalmanSensor(sys, dt=DT).fit(y_col)
+    plain = KalmanSensor(sys, dt=DT, calibrate=False).fit(y_col)
+    assert np.all(plain.interval_scale_ == 1.0) and plain.calibration_["raw_scale"].tolist() == [1.0] * 4
+    assert not calibrated.calibration_["held_out"]  # every sample went into the likelihood: calibrated in-sample
+    assert np.all(calibrated.interval_scale_ >= 1.0) and calibrated.interval_scale_[[0, 1, 3]].min() > 1.2
+    mask = np.ones((600, 4), dtype=bool)
+    mask[:, 1] = False  # x2 hidden
+    mask[300:, 3] = False  # a2 lost half-way
+    est_c, std_c = calibrated.reconstruct(y_test[:600], mask, return_std=True)
+    est_p, std_p = plain.reconstruct(y_test[:600], mask, return_std=True)
+    np.testing.assert_array_equal(est_c, est_p)  # the estimates are the same filter's
+    expected = np.where(mask, 1.0, calibrated.interval_scale_)  # measured channels keep the filter's std
+    np.testing.assert_allclose(std_c, std_p * expected, rtol=1e-12)
+
+
+def test_calibration_restores_coverage_with_coloured_sensor_noise(oscillator):
+    """White plus AR(1) sensor noise on every channel: the white-noise filter's intervals of a hidden channel are
+    far too narrow, the calibrated ones about right (to the precision of the calibration, whose weak point is the
+    hidden channel's own noise: see KalmanSensor._calibrate)."""
+    _, y_train, y_test, truth, _ = oscillator
+    sys = two_dof_system()
+    col = np.array([0.004, 0.004, 0.1, 0.1])
+    y_train = y_train + coloured_noise(y_train.shape[0], 11, col, tau=2.0)
+    y_test = y_test + coloured_noise(y_test.shape[0], 12, col, tau=2.0)
+    calibrated = KalmanSensor(sys, dt=DT).fit(y_train)
+    plain = copy.deepcopy(calibrated)
+    plain.interval_scale_ = np.ones(4)
+    plain._std_scale = plain.scale_.copy()
+    for hidden in (0, 1, 3):
+        mask = np.ones(4, dtype=bool)
+        mask[hidden] = False
+        est, std = calibrated.reconstruct(y_test, mask, return_std=True)
+        _, std_plain = plain.reconstruct(y_test, mask, return_std=True)
+        err = np.abs(truth[:, hidden] - est[:, hidden])
+        cover = np.mean(err <= 1.96 * std[:, hidden])
+        cover_plain = np.mean(err <= 1.96 * std_plain[:, hidden])
+        print(f"\n2-DOF with coloured noise, channel {hidden} hidden: 95% coverage {cover_plain:.3f} -> {cover:.3f}")
+        assert cover_plain < 0.85
+        assert 0.88 <= cover <= 0.99
 
 
 def steady_state_loglik(sys: control.StateSpace, sensor: KalmanSensor, segments: list[np.ndarray]) -> float:
@@ -472,3 +528,31 @@ def test_intervals_are_calibrated_on_surrogate_data_with_white_sensor_noise():
         _, _, cover_h = scenario_scores(surrogates, model, sensor, name, duration=300.0)
         print(f"\nscenario {name}, white sensor noise: 95% coverage {np.round(cover_h, 3)}")
         assert np.all((cover_h >= 0.88) & (cover_h <= 0.99))
+
+
+@pytest.fixture(scope="module")
+def paper_sensor_default_noise():
+    surrogates = pytest.importorskip("surrogates")
+    model = surrogates.FOWTModel()
+    return surrogates, model, fit_surrogate_sensor(surrogates, model, PAPER_TRAIN, duration=300.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", [
+    "B",
+    pytest.param("A", marks=pytest.mark.xfail(strict=True, reason=(
+        "TwHt3MLyt (channel 11) covers 0.81: its calibration factor comes out 1.18 where about 1.5-1.75 is "
+        "needed, because the realised variance of its slow sensor noise over the held-out training data is 6 % "
+        "below the fitted noise variance, which the calibration subtracts and which is 13 times the filter's "
+        "error variance for that channel (see KalmanSensor._calibrate); the other seven channels cover 0.95-0.98"))),
+])
+def test_intervals_are_calibrated_on_surrogate_data_with_default_noise(paper_sensor_default_noise, name):
+    """The surrogate's default sensor noise (white plus a slow AR(1) part on every tower channel): train on the
+    paper's OLCs (300 s each), test scenarios A and B on held-out records; the 95 % intervals of the hidden
+    channels must cover the truth 90-98 % of the time (without the calibration: 45-96 %)."""
+    surrogates, model, sensor = paper_sensor_default_noise
+    assert sensor.calibration_["held_out"]
+    r2_h, _, cover_h = scenario_scores(surrogates, model, sensor, name, duration=300.0)
+    print(f"\nscenario {name}, default sensor noise: R2 {np.round(r2_h, 5)}, 95% coverage {np.round(cover_h, 3)}")
+    assert np.median(r2_h) >= 0.999 and r2_h.min() >= 0.995
+    assert np.all((cover_h >= 0.90) & (cover_h <= 0.98))
