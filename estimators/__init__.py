@@ -6,7 +6,8 @@ Never imports :mod:`surrogates` or Gymnasium: the same code runs on surrogate, O
 * identification -- :class:`HankelDMD`, :class:`SSICov`, :func:`mac`, :func:`pair_modes`,
   :func:`probabilistic_mode_shapes`, :func:`harmonic_candidates`, :func:`lyapunov_exponent` (Rosenstein);
 * virtual sensors -- :class:`HankelDMDSensor` (causal rolling-horizon Hankel-DMD), :class:`KalmanSensor`
-  (augmented Kalman filter on a linear model), :class:`HoldLastValue` (floor baseline);
+  (augmented Kalman filter on a linear model), :class:`KoopmanKalmanSensor` (Kalman filter on the identified
+  Hankel-DMD operator), :class:`HoldLastValue` (floor baseline);
 * scores -- :func:`r2_score`, :func:`nrmse`, :func:`reconstruction_scores` (the seed paper's definitions);
 * errors -- :class:`NotFittedError` (a ``ValueError``).
 """
@@ -15,6 +16,7 @@ from .baseline import HoldLastValue
 from .dmd_sensor import HankelDMDSensor
 from .hankel_dmd import HankelDMD, harmonic_candidates, svht_omega, svht_rank
 from .kalman import KalmanSensor
+from .koopman_kalman import KoopmanKalmanSensor
 from .lyapunov import (
     LyapunovResult,
     delay_embedding_lag,
@@ -34,6 +36,7 @@ __all__ = [
     "HankelDMDSensor",
     "HoldLastValue",
     "KalmanSensor",
+    "KoopmanKalmanSensor",
     "LyapunovResult",
     "ModeShapeDistribution",
     "NotFittedError",

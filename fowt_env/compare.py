@@ -150,12 +150,12 @@ _dmd.refit_per_interval = False  # type: ignore[attr-defined]  # the interval is
 
 
 def _koopman(dt: float, update_interval: float | None, *, channels: Sequence[str] | None = None,
-             delays: int | float = 60, rank: int | float | str = 90, **options: Any) -> Any:
-    """:class:`estimators.koopman_kalman.KoopmanKalmanSensor` (a Kalman filter on the Hankel-DMD model);
-    assimilates every sample, so ``update_interval`` is ignored."""
+             **options: Any) -> Any:
+    """:class:`estimators.koopman_kalman.KoopmanKalmanSensor` (a Kalman filter on the Hankel-DMD model, its
+    own defaults: 60 delay samples, rank 40); assimilates every sample, so ``update_interval`` is ignored."""
     from estimators.koopman_kalman import KoopmanKalmanSensor
 
-    return KoopmanKalmanSensor(delays=delays, rank=rank, dt=dt, **options)
+    return KoopmanKalmanSensor(dt=dt, **options)
 
 
 _koopman.uses_update_interval = False  # type: ignore[attr-defined]

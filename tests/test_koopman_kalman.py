@@ -1,0 +1,439 @@
+"""``estimators.koopman_kalman.KoopmanKalmanSensor`` against independent truth: a 2-DOF oscillator with known white
+and coloured sensor noise simulated exactly here, a textbook time-varying Kalman filter written here for the filter
+recursion, and the surrogate's noise-free records (the paper's virtual-sensing scenarios); causality, streaming =
+batch, robustness to dropouts, blackouts, spikes and stuck sensors, and clear errors for bad input."""
+
+import copy
+import doctest
+import time
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+
+import estimators.koopman_kalman
+from estimators.baseline import HoldLastValue
+from estimators.koopman_kalman import KoopmanKalmanSensor
+from estimators.metrics import nrmse, r2_score
+from estimators.validation import NotFittedError
+
+try:  # BLAS threads only slow the small per-sample products down on a shared 2-core machine
+    from threadpoolctl import threadpool_limits
+except ImportError:  # pragma: no cover
+    threadpool_limits = None
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _one_blas_thread():
+    if threadpool_limits is None:  # pragma: no cover
+        yield
+        return
+    with threadpool_limits(limits=1, user_api="blas"):
+        yield
+
+
+# ---------------------------------------------------------------------------------- a known linear system
+DT = 0.02  # s
+WHITE = np.array([0.002, 0.002, 0.01, 0.01])  # white sensor noise: m, m, m/s, m/s
+COLOURED = np.array([0.002, 0.002, 0.01, 0.01])  # coloured (AR(1)) sensor error, same units
+TAU_NOISE = 5.0  # s, its correlation time
+
+
+def simulate_two_dof(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Two masses in a chain, an AR(1) random force (tau 0.5 s, 5 N) on mass 1 held over each sample, integrated
+    exactly with the matrix exponential; outputs the displacements and velocities, plus white and AR(1) coloured
+    sensor noise. Returns (measured, truth), both (n, 4)."""
+    m = np.diag([1.0, 0.5])
+    k = np.array([[65.0, -25.0], [-25.0, 25.0]])
+    c = np.array([[0.6, -0.2], [-0.2, 0.2]])
+    mi = np.linalg.inv(m)
+    a = np.block([[np.zeros((2, 2)), np.eye(2)], [-mi @ k, -mi @ c]])
+    b = np.vstack([np.zeros((2, 1)), mi[:, [0]]])
+    e = sla.expm(np.block([[a, b], [np.zeros((1, 5))]]) * DT)
+    phi_x, gam = e[:4, :4], e[:4, 4]
+    rng = np.random.default_rng(seed)
+    n_warm = 3000
+    total = n + n_warm
+    phi = np.exp(-DT / 0.5)
+    f = np.empty(total)
+    f[0] = 5.0 * rng.standard_normal()
+    w = 5.0 * np.sqrt(1.0 - phi**2) * rng.standard_normal(total)
+    for i in range(1, total):
+        f[i] = phi * f[i - 1] + w[i]
+    x = np.zeros(4)
+    xs = np.empty((total, 4))
+    for i in range(total):
+        xs[i] = x
+        x = phi_x @ x + gam * f[i]
+    truth = xs[n_warm:] + np.array([0.1, -0.2, 0.0, 0.0])
+    phn = np.exp(-DT / TAU_NOISE)
+    col = np.empty((n, 4))
+    col[0] = COLOURED * rng.standard_normal(4)
+    eta = COLOURED * np.sqrt(1.0 - phn**2) * rng.standard_normal((n, 4))
+    for i in range(1, n):
+        col[i] = phn * col[i - 1] + eta[i]
+    return truth + WHITE * rng.standard_normal(truth.shape) + col, truth
+
+
+@pytest.fixture(scope="module")
+def oscillator():
+    y_train, _ = simulate_two_dof(30000, seed=1)
+    y_test, truth = simulate_two_dof(10000, seed=2)
+    sensor = KoopmanKalmanSensor(delays=20, rank=10, dt=DT).fit(y_train)
+    return y_train, y_test, truth, sensor
+
+
+def test_learns_the_sensor_noise_and_reconstructs_a_hidden_output_with_calibrated_intervals(oscillator):
+    y_train, y_test, truth, sensor = oscillator
+    # the sensor-error model is learned from the data alone: white and coloured levels and the time constant
+    assert np.all((sensor.white_noise_std_ > 0.5 * WHITE) & (sensor.white_noise_std_ < 2.0 * WHITE))
+    assert np.all((sensor.coloured_noise_std_ > COLOURED / 1.5) & (sensor.coloured_noise_std_ < 1.5 * COLOURED))
+    assert TAU_NOISE / 2 < sensor.noise_time_constant_ < 2 * TAU_NOISE
+    assert sensor.em_log_likelihood_ == sorted(sensor.em_log_likelihood_)  # EM iterates never lower it
+    assert sensor.em_log_likelihood_[0] == pytest.approx(max(s["log_likelihood"] for s in sensor.search_))
+    assert sensor.log_likelihood_ == sensor.em_log_likelihood_[-1]
+    baseline = HoldLastValue(fill="mean").fit(y_train)
+    for hidden in (0, 3):
+        mask = np.ones(4, dtype=bool)
+        mask[hidden] = False
+        est, std = sensor.reconstruct(y_test, mask, return_std=True)
+        keep = slice(500, None)  # 10 s of start-up
+        err = truth[keep, hidden] - est[keep, hidden]
+        r2 = r2_score(truth[keep, hidden], est[keep, hidden])
+        base = baseline.reconstruct(y_test, mask)
+        rmse_base = np.sqrt(np.mean((truth[keep, hidden] - base[keep, hidden]) ** 2))
+        coverage = np.mean(np.abs(err) <= 1.96 * std[keep, hidden])
+        print(f"\n2-DOF, channel {hidden} hidden: R2 {r2:.6f}, RMSE {np.sqrt(np.mean(err**2)):.2e} "
+              f"(baseline {rmse_base:.2e}), 95% coverage {coverage:.3f}")
+        assert r2 > 0.9995
+        assert np.sqrt(np.mean(err**2)) < 0.05 * rmse_base
+        assert 0.90 <= coverage <= 0.995
+
+
+def textbook_filter(sensor: KoopmanKalmanSensor, Y: np.ndarray, masks: np.ndarray):
+    """The model written out from the sensor's public attributes and filtered by the plain time-varying Kalman
+    recursion (no gating, no caches): estimates and standard deviations of C a in channel units."""
+    r, p = sensor.rank_, sensor.n_channels_
+    phi = np.exp(-DT / sensor.noise_time_constant_)
+    sc = sensor.coloured_noise_std_ / sensor.scale_
+    F = sla.block_diag(sensor.transition_, phi * np.eye(p))
+    Q = sla.block_diag(sensor.process_cov_, np.diag((1 - phi**2) * sc**2))
+    H = np.hstack([sensor.observation_, np.eye(p)])
+    R = np.diag((sensor.white_noise_std_ / sensor.scale_) ** 2)
+    x, P = np.zeros(r + p), sla.block_diag(sensor.koopman_cov_, np.diag(sc**2))
+    est, std = np.empty_like(Y), np.empty_like(Y)
+    Cout = np.hstack([sensor.observation_, np.zeros((p, p))])
+    for k, (y, m) in enumerate(zip(Y, masks, strict=True)):
+        if m.any():
+            z = (y[m] - sensor.mean_[m]) / sensor.scale_[m]
+            h = H[m]
+            s = h @ P @ h.T + R[np.ix_(m, m)]
+            gain = P @ h.T @ np.linalg.inv(s)
+            x = x + gain @ (z - h @ x)
+            ikh = np.eye(r + p) - gain @ h
+            P = ikh @ P @ ikh.T + gain @ R[np.ix_(m, m)] @ gain.T  # Joseph form
+        est[k] = sensor.mean_ + sensor.scale_ * (Cout @ x)
+        std[k] = sensor.scale_ * np.sqrt(np.diag(Cout @ P @ Cout.T))
+        x, P = F @ x, F @ P @ F.T + Q
+        P = 0.5 * (P + P.T)
+    return est, std
+
+
+def test_filter_recursion_matches_a_textbook_kalman_filter(oscillator):
+    _, y_test, _, sensor = oscillator
+    ungated = copy.deepcopy(sensor)
+    ungated.gate_sigma = None
+    rng = np.random.default_rng(3)
+    n_random, n_fixed = 400, 4000
+    masks = np.vstack([rng.random((n_random, 4)) < 0.6, np.tile([True, False, True, True], (n_fixed, 1))])
+    masks[50:60] = False  # a short blackout
+    Y = y_test[: n_random + n_fixed]
+    est, std = ungated.reconstruct(Y, masks, return_std=True)
+    assert ungated._steady is not None  # the long fixed stretch ran on the cached steady-state gain
+    ref_est, ref_std = textbook_filter(ungated, Y, masks)
+    np.testing.assert_allclose(est, ref_est, rtol=0, atol=1e-7 * sensor.scale_.max())
+    np.testing.assert_allclose(std, ref_std, rtol=1e-6)
+    assert ungated.n_blind_ == int((~masks.any(axis=1)).sum()) >= 10
+
+
+def test_streaming_update_equals_reconstruct(oscillator):
+    _, y_test, _, sensor = oscillator
+    y = y_test[:800].copy()
+    rng = np.random.default_rng(4)
+    mask = rng.random(y.shape) > 0.3
+    mask[300:] = [True, True, False, True]
+    y[450, 2] += 100 * sensor.scale_[2]  # a spike for the gate
+    batch, batch_std = sensor.reconstruct(np.where(mask, y, np.nan), mask, return_std=True)
+    n_gated = sensor.n_gated_
+    sensor.reset()
+    for k in range(y.shape[0]):
+        est, std = sensor.update(np.where(mask[k], y[k], np.nan), mask[k], return_std=True)
+        np.testing.assert_allclose(est, batch[k], rtol=0, atol=1e-12 * sensor.scale_.max())
+        np.testing.assert_allclose(std, batch_std[k], rtol=1e-12)
+        np.testing.assert_array_equal(sensor.std_, std)
+    assert sensor.n_gated_ == n_gated
+
+
+def test_causal_estimates_do_not_see_the_future(oscillator):
+    _, y_test, _, sensor = oscillator
+    y = y_test[:1200].copy()
+    mask = np.ones(y.shape, dtype=bool)
+    mask[:, 1] = False
+    k = 600
+    est_a, std_a = sensor.reconstruct(y, mask, return_std=True)
+    y_b, mask_b = y.copy(), mask.copy()
+    rng = np.random.default_rng(5)
+    y_b[k + 1 :] = rng.standard_normal(y_b[k + 1 :].shape) * 100.0
+    mask_b[k + 1 :] = rng.random(mask_b[k + 1 :].shape) > 0.5
+    est_b, std_b = sensor.reconstruct(y_b, mask_b, return_std=True)
+    np.testing.assert_allclose(est_b[: k + 1], est_a[: k + 1], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(std_b[: k + 1], std_a[: k + 1], rtol=0, atol=1e-9)
+    assert not np.allclose(est_b[k + 1 :], est_a[k + 1 :])
+
+
+def test_docstring_example_runs():
+    result = doctest.testmod(estimators.koopman_kalman, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert result.attempted > 0 and result.failed == 0
+
+
+def test_bad_input_gives_clear_errors(oscillator):
+    y_train, y_test, _, sensor = oscillator
+    with pytest.raises(ValueError, match=r"y must have shape \(4,\)"):
+        sensor.update(np.zeros(3), np.ones(3, dtype=bool))
+    with pytest.raises(ValueError, match="mask must have shape"):
+        sensor.update(np.zeros(4), np.ones(5, dtype=bool))
+    with pytest.raises(ValueError, match=r"±inf"):
+        sensor.update(np.array([np.inf, 0.0, 0.0, 0.0]), np.ones(4, dtype=bool))
+    with pytest.raises(ValueError, match="must have 4 channels"):
+        sensor.reconstruct(y_test[:, :3])
+    with pytest.raises(ValueError, match="mask must have shape"):
+        sensor.reconstruct(y_test[:10], np.ones((9, 4), dtype=bool))
+    with pytest.raises(NotFittedError, match="not fitted"):
+        KoopmanKalmanSensor().update(np.zeros(4), np.ones(4, dtype=bool))
+    with pytest.raises(ValueError, match="not fitted"):
+        KoopmanKalmanSensor().reconstruct(y_test[:10])
+    with pytest.raises(ValueError, match="not fitted"):
+        KoopmanKalmanSensor().reset()
+    short = y_train[:3000]
+    with pytest.raises(ValueError, match="gate_sigma"):
+        KoopmanKalmanSensor(delays=10, rank=4, gate_sigma=-1.0).fit(short)
+    with pytest.raises(ValueError, match="delays"):
+        KoopmanKalmanSensor(delays=0.5, rank=4).fit(short)  # seconds without dt
+    with pytest.raises(ValueError, match="rank"):
+        KoopmanKalmanSensor(delays=10, rank=100).fit(short)  # more than p * delays = 40
+    with pytest.raises(ValueError, match="max_modulus"):
+        KoopmanKalmanSensor(delays=10, rank=4, max_modulus=1.5).fit(short)
+    with pytest.raises(ValueError, match="constant channel"):
+        KoopmanKalmanSensor(delays=10, rank=4).fit(np.c_[short, np.ones(3000)])
+    with pytest.raises(ValueError, match="mask"):
+        KoopmanKalmanSensor(delays=10, rank=4).fit(short, mask=np.ones((5, 4), dtype=bool))
+    with pytest.raises(ValueError, match="channels"):
+        KoopmanKalmanSensor(delays=10, rank=4).fit([short, short[:, :3]])
+    holes = np.where(np.arange(3000)[:, None] % 8 == 0, np.nan, short)
+    with pytest.raises(ValueError, match="every channel is available"):
+        KoopmanKalmanSensor(delays=10, rank=4).fit(holes)
+
+
+def test_fit_with_missing_training_samples_and_a_list_of_records(oscillator):
+    y_train, y_test, truth, _ = oscillator
+    y = y_train[:20000].copy()
+    mask = np.ones(y.shape, dtype=bool)
+    mask[5000:5100, 2] = False  # a dropout in the training data
+    y[7000, 0] = np.nan
+    sensor = KoopmanKalmanSensor(delays=20, rank=10, dt=DT, em_iter=3).fit(
+        [y[:12000], y[12000:]], mask=[mask[:12000], mask[12000:]]
+    )
+    assert np.all(np.isfinite(sensor.mean_)) and sensor.n_channels_ == 4
+    est = sensor.reconstruct(y_test[:4000], np.array([True, False, True, True]))
+    assert r2_score(truth[500:4000, 1], est[500:, 1]) > 0.999
+
+
+# ------------------------------------------------------------------------------ the surrogate (OC3 spar, FA)
+SURROGATE_DT = 0.0125  # s (80 Hz)
+SCENARIOS = {"A": (5, (2, 3, 5, 7, 11, 12, 14, 16)), "B": (7, (0, 8, 9, 17)), "C": (2, (0, 8, 9, 17))}
+PAPER_TRAIN = (1, 3, 4, 6, 8, 9, 10, 11, 12)
+HIDDEN_B = [0, 8, 9, 17]
+
+
+def fit_surrogate_sensor(surrogates, model, cases, duration, **kwargs) -> KoopmanKalmanSensor:
+    train = [surrogates.simulate(model, c, duration=duration, seed=100 + c).planar("FA").y for c in cases]
+    return KoopmanKalmanSensor(dt=SURROGATE_DT, **kwargs).fit(train)
+
+
+def scenario_scores(surrogates, model, sensor, name, duration, seed=7):
+    case, hidden = SCENARIOS[name]
+    noisy, truth = surrogates.simulate(model, case, duration=duration, seed=seed, return_truth=True)
+    y, t = noisy.planar("FA").y, truth.planar("FA").y
+    mask = np.ones(18, dtype=bool)
+    mask[list(hidden)] = False
+    est, std = sensor.reconstruct(np.where(mask, y, np.nan), mask, return_std=True)
+    h = list(hidden)
+    cover = np.mean(np.abs(t - est) <= 1.96 * std, axis=0)
+    return r2_score(t, est)[h], nrmse(t, est)[h], cover[h]
+
+
+@pytest.fixture(scope="module")
+def spar():
+    surrogates = pytest.importorskip("surrogates")
+    model = surrogates.FOWTModel()
+    sensor = fit_surrogate_sensor(surrogates, model, (1, 6, 11), duration=200.0, em_iter=5)
+    noisy, truth = surrogates.simulate(model, 7, duration=60.0, seed=21, return_truth=True)
+    return surrogates, model, sensor, noisy.planar("FA").y, truth.planar("FA").y
+
+
+def hidden_b_mask(n: int) -> np.ndarray:
+    mask = np.ones((n, 18), dtype=bool)
+    mask[:, HIDDEN_B] = False
+    return mask
+
+
+def test_scenario_b_on_surrogate_data(spar):
+    surrogates, model, sensor, _, _ = spar
+    r2_h, nrmse_h, cover_h = scenario_scores(surrogates, model, sensor, "B", duration=300.0)
+    print(f"\nscenario B (OLC 7, hidden 0, 8, 9, 17), trained on OLC 1, 6, 11 (200 s each): R2 {np.round(r2_h, 5)}, "
+          f"NRMSE {np.round(nrmse_h, 5)}, 95% coverage {np.round(cover_h, 3)}")
+    assert np.median(r2_h) >= 0.95 and r2_h.min() >= 0.85  # the issue's target
+    assert np.median(r2_h) >= 0.999 and r2_h.min() >= 0.995  # what the sensor reaches, with margin
+    assert np.all(nrmse_h < 0.01)
+    assert np.all(cover_h >= 0.85) and 0.90 <= np.mean(cover_h) <= 0.995
+
+
+def test_sensor_noise_learned_from_the_surrogate(spar):
+    """The surrogate's default sensor noise (surrogates.SensorNoise): white 0.005 m/s² and 20 kN·m, coloured
+    (AR(1), 5 s) 0.002 m/s² and 20 kN·m."""
+    _, _, sensor, _, _ = spar
+    white = sensor.white_noise_std_
+    np.testing.assert_allclose(white[:9], 0.005, rtol=0.15)
+    np.testing.assert_allclose(white[9:], 20.0, rtol=0.25)
+    assert np.all((sensor.coloured_noise_std_[9:] > 10.0) & (sensor.coloured_noise_std_[9:] < 40.0))
+    assert np.all(sensor.coloured_noise_std_[:9] < 0.005)
+    assert 1.0 < sensor.noise_time_constant_ < 20.0
+
+
+def test_nan_in_live_channels_is_a_dropout(spar):
+    _, _, sensor, y, truth = spar
+    rng = np.random.default_rng(5)
+    mask = hidden_b_mask(y.shape[0])
+    holes = (rng.random(y.shape) < 0.05) & mask
+    est_nan = sensor.reconstruct(np.where(holes, np.nan, y), mask)
+    est_masked = sensor.reconstruct(y, mask & ~holes)
+    assert np.all(np.isfinite(est_nan))
+    np.testing.assert_array_equal(est_nan, est_masked)
+    assert r2_score(truth, est_nan)[HIDDEN_B].min() > 0.99
+
+
+def test_total_blackout_predicts_and_recovers(spar):
+    _, _, sensor, y, truth = spar
+    mask = hidden_b_mask(y.shape[0])
+    uninterrupted = sensor.reconstruct(np.where(mask, y, np.nan), mask)
+    n_gated_uninterrupted = sensor.n_gated_
+    k0, k1 = 1600, 1600 + 240  # 3 s at 80 Hz, from t = 20 s
+    mask[k0:k1] = False
+    est, std = sensor.reconstruct(np.where(mask, y, np.nan), mask, return_std=True)
+    assert np.all(np.isfinite(est)) and np.all(np.isfinite(std))
+    assert sensor.n_blind_ == k1 - k0  # pure prediction for exactly the blackout
+    assert sensor.n_gated_ <= n_gated_uninterrupted + 2  # the returning channels are not locked out
+    assert np.all(std[k1 - 1] > 2.0 * std[k0 - 1])  # the uncertainty grows during the blackout
+    after = slice(k1 + 800, None)  # 10 s after the sensors return
+    assert np.all(r2_score(uninterrupted[after], est[after]) > 0.999)
+    assert np.all(r2_score(truth[after], est[after]) > r2_score(truth[after], uninterrupted[after]) - 1e-3)
+    assert np.all(std[-1] < 1.5 * std[k0 - 1])
+
+
+def test_mask_changing_every_sample(spar):
+    _, _, sensor, y, truth = spar
+    rng = np.random.default_rng(6)
+    mask = rng.random(y.shape) < 0.6
+    est, std = sensor.reconstruct(np.where(mask, y, np.nan), mask, return_std=True)
+    assert np.all(np.isfinite(est)) and np.all(np.isfinite(std))
+    assert r2_score(truth, est).min() > 0.99
+
+
+def test_spikes_are_gated(spar):
+    _, _, sensor, y, truth = spar
+    mask = hidden_b_mask(y.shape[0])
+    rng = np.random.default_rng(7)
+    spikes = (rng.random(y.shape) < 0.005) & mask
+    y_spiky = y + spikes * rng.choice([-1.0, 1.0], size=y.shape) * 30.0 * sensor.scale_
+    clean = r2_score(truth, sensor.reconstruct(y, mask))[HIDDEN_B]
+    gated = r2_score(truth, sensor.reconstruct(y_spiky, mask))[HIDDEN_B]
+    assert sensor.n_gated_ >= 0.9 * spikes.sum()
+    ungated_sensor = copy.deepcopy(sensor)
+    ungated_sensor.gate_sigma = None
+    ungated = r2_score(truth, ungated_sensor.reconstruct(y_spiky, mask))[HIDDEN_B]
+    assert ungated_sensor.n_gated_ == 0
+    print(f"\nspikes on 0.5% of live samples: hidden R2 clean {np.round(clean, 5)}, gated {np.round(gated, 5)}, "
+          f"ungated {np.round(ungated, 5)}")
+    assert np.all(gated > clean - 0.002)
+    assert np.all(ungated < gated)
+
+
+def test_stuck_sensor_is_rejected(spar):
+    _, _, sensor, y, truth = spar
+    mask = hidden_b_mask(y.shape[0])
+    y_stuck = y.copy()
+    y_stuck[800:, 4] = y[800, 4]  # gauge-5 accelerometer frozen from t = 10 s, still reported available
+    est = sensor.reconstruct(y_stuck, mask)
+    assert np.all(np.isfinite(est))
+    assert sensor.gated_counts_[4] > 0.5 * (y.shape[0] - 800)
+    assert r2_score(truth, est)[HIDDEN_B].min() > 0.99
+
+
+def test_wrong_channel_count_on_the_surrogate_model(spar):
+    _, _, sensor, y, _ = spar
+    with pytest.raises(ValueError, match=r"y must have shape \(18,\)"):
+        sensor.update(y[0, :17], np.ones(17, dtype=bool))
+    with pytest.raises(ValueError, match="must have 18 channels"):
+        sensor.reconstruct(np.hstack([y, y[:, :1]]))
+
+
+def test_per_sample_cost(spar):
+    _, _, sensor, y, _ = spar
+    mask = hidden_b_mask(y.shape[0])[0]
+    sensor.reset()
+    n = 1000
+    t0 = time.perf_counter()
+    for k in range(n):
+        sensor.update(y[k], mask)
+    per_sample = (time.perf_counter() - t0) / n
+    print(f"\nupdate(): {1e6 * per_sample:.0f} us per sample (rank {sensor.rank_}, {sensor.rank_ + 18} states, "
+          "time-varying covariance)")
+    assert per_sample < 5e-3  # loose: the machine is shared; typically ~0.1 ms
+
+
+# ----------------------------------------------------------------------------------------------- slow checks
+@pytest.mark.slow
+def test_paper_scenarios_on_surrogate_data():
+    """Train on the paper's OLCs 1, 3, 4, 6, 8-12 (300 s each), test scenarios A, B, C (600 s)."""
+    surrogates = pytest.importorskip("surrogates")
+    model = surrogates.FOWTModel()
+    sensor = fit_surrogate_sensor(surrogates, model, PAPER_TRAIN, duration=300.0)
+    for name in "ABC":
+        r2_h, nrmse_h, cover_h = scenario_scores(surrogates, model, sensor, name, duration=600.0)
+        print(f"\nscenario {name}: R2 {np.round(r2_h, 5)} (median {np.median(r2_h):.5f}), "
+              f"NRMSE {np.round(nrmse_h, 5)}, 95% coverage {np.round(cover_h, 3)}")
+        assert np.median(r2_h) >= 0.95 and r2_h.min() >= 0.85  # the issue's target
+        assert np.median(r2_h) >= 0.9995 and r2_h.min() >= 0.999
+        if name in "AB":
+            # lower end of the target met; channels lost between live neighbours are conservative (see module)
+            assert np.all(cover_h >= 0.88) and np.all(cover_h <= 0.9995)
+
+
+@pytest.mark.slow
+def test_per_sample_cost_at_rank_90():
+    surrogates = pytest.importorskip("surrogates")
+    model = surrogates.FOWTModel()
+    sensor = fit_surrogate_sensor(surrogates, model, (1, 6, 11), duration=200.0, rank=90, em_iter=2)
+    y = surrogates.simulate(model, 7, duration=300.0, seed=3).planar("FA").y
+    mask = np.ones(18, dtype=bool)
+    mask[HIDDEN_B] = False
+    sensor.reset()
+    times = np.empty(y.shape[0])
+    for k in range(y.shape[0]):
+        t0 = time.perf_counter()
+        sensor.update(y[k], mask)
+        times[k] = time.perf_counter() - t0
+    early, late = np.median(times[:2000]), np.median(times[-2000:])
+    print(f"\nrank 90 (108 states): {1e6 * early:.0f} us per sample while the covariance converges, "
+          f"{1e6 * late:.0f} us on the cached steady state")
+    assert late < early and late < 1e-3
