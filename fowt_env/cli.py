@@ -49,6 +49,14 @@ def _case(arg: str):
         raise SystemExit(f"fowt-env: --case: {exc}") from exc
 
 
+def _save_record(rec, path: str | Path) -> Path:
+    """Save by extension (.npz, .out, .outb, .csv, .parquet; none = .npz) via :func:`fowt_env.io.save_record`."""
+    from .io import save_record
+
+    path = Path(path)
+    return save_record(rec, path if path.suffix else path.with_suffix(".npz"))
+
+
 def _cmd_simulate(args: argparse.Namespace) -> int:
     import surrogates
 
@@ -57,7 +65,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     rec = surrogates.simulate(model, _case(args.case), duration=args.duration, dt=args.dt, seed=args.seed,
                               noise=not args.no_noise)
     wall = time.perf_counter() - t0
-    path = rec.save(args.out)
+    path = _save_record(rec, args.out)
     print(f"wrote {path}: {rec.n_samples} samples x {rec.n_channels} channels, {rec.duration:.1f} s simulated "
           f"in {wall:.2f} s ({rec.duration / wall:.0f}x real time)")
     return 0
@@ -139,8 +147,8 @@ def _cmd_episode(args: argparse.Namespace) -> int:
     measured = surrogates.Record(np.array(t), np.array(meas), env.channels, units, {**meta, "kind": "measured"})
     true_rec = surrogates.Record(np.array(t), np.array(truth), env.channels, units, {**meta, "kind": "truth"})
     out = Path(args.out)
-    p1 = measured.save(out)
-    p2 = true_rec.save(out.with_name(out.stem + "_truth" + out.suffix))
+    p1 = _save_record(measured, out)
+    p2 = _save_record(true_rec, out.with_name(out.stem + "_truth" + (out.suffix or ".npz")))
     lost = np.isnan(measured.y).mean()
     print(f"{len(t)} steps ({t[-1]:.1f} s) in {wall:.2f} s; {100 * lost:.1f} % of samples lost")
     print(f"wrote {p1} (measured, NaN where lost)\nwrote {p2} (noise-free truth)")
@@ -152,7 +160,7 @@ def _cmd_discrepancy(args: argparse.Namespace) -> int:
 
     from . import discrepancy
 
-    measured = surrogates.Record.load(args.measured)
+    measured = _load_record(args.measured, args.channel_map)
     model = surrogates.FOWTModel(_parse_effects(args.model_effects))
     cands = args.candidates.split(",") if args.candidates else None
     t0 = time.perf_counter()
@@ -167,16 +175,15 @@ def _cmd_discrepancy(args: argparse.Namespace) -> int:
     return 0
 
 
-def _load_record(path: str):
-    import surrogates
+def _load_record(path: str, channel_map: str | None = None):
+    """Any record file fowt_env.io reads (.npz, .out, .outb, .csv, .parquet); one-line exit on any problem."""
+    from .io import load_channel_map, load_record
 
-    p = Path(path)
-    if not p.exists():
-        raise SystemExit(f"fowt-env: no such file: {path}")
     try:
-        return surrogates.Record.load(p)
-    except (OSError, KeyError, ValueError) as exc:
-        raise SystemExit(f"fowt-env: cannot read {path} as a record: {exc}") from exc
+        mapping = load_channel_map(channel_map) if channel_map else None
+        return load_record(path, channel_map=mapping, unknown_channels="keep")
+    except ValueError as exc:
+        raise SystemExit(f"fowt-env: {exc}") from None
 
 
 def _identification_reference(rec, case_arg: str | None, plane: str | None, effects: str):
@@ -197,7 +204,7 @@ def _identification_reference(rec, case_arg: str | None, plane: str | None, effe
 def _cmd_identify(args: argparse.Namespace) -> int:
     from .identification import identify
 
-    rec = _load_record(args.record)
+    rec = _load_record(args.record, args.channel_map)
     channels = args.channels.split(",") if args.channels else None
     ref = None if args.no_reference else _identification_reference(rec, args.case, args.plane, args.effects)
     rank: int | float | str = args.rank if args.rank == "auto" else (float(args.rank) if "." in args.rank
@@ -347,7 +354,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--effects", default="all", help="'all', 'none' or name=strength,... (others nominal)")
     s.add_argument("--no-noise", action="store_true", help="noise-free sensors")
-    s.add_argument("--out", required=True, help="output .npz file")
+    s.add_argument("--out", required=True, help="output file: .npz (lossless), .out/.outb (OpenFAST), .csv or .parquet")
     s.set_defaults(func=_cmd_simulate)
 
     e = sub.add_parser("episode", help="run an environment episode under sensor faults and save the records")
@@ -364,7 +371,10 @@ def build_parser() -> argparse.ArgumentParser:
     e.set_defaults(func=_cmd_episode)
 
     q = sub.add_parser("discrepancy", help="find and name the physical effect a model misses in a measured record")
-    q.add_argument("measured", help="measured record (.npz written by fowt-env or surrogates.Record.save)")
+    q.add_argument("measured",
+                   help="measured record: .npz (fowt-env), OpenFAST .out/.outb, or .csv/.parquet field data")
+    q.add_argument("--channel-map", default=None, metavar="FILE.json",
+                   help='JSON object renaming file columns to channel names, e.g. {"acc_top_x": "TwHt9ALxt"}')
     q.add_argument("--case", required=True, help="OLC number of the measured conditions")
     q.add_argument("--model-effects", default="all", help="candidate model: 'all', 'none' or name=strength,...")
     q.add_argument("--candidates", default=None, help="comma-separated effects to consider (default all)")
@@ -375,7 +385,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.set_defaults(func=_cmd_discrepancy)
 
     i = sub.add_parser("identify", help="identify modes of a record with Hankel-DMD and SSI-COV (Table-3 style)")
-    i.add_argument("record", help="record file (.npz written by fowt-env or surrogates.Record.save)")
+    i.add_argument("record", help="record file: .npz (fowt-env), OpenFAST .out/.outb, or .csv/.parquet field data")
+    i.add_argument("--channel-map", default=None, metavar="FILE.json",
+                   help='JSON object renaming file columns to channel names, e.g. {"acc_top_x": "TwHt9ALxt"}')
     i.add_argument("--plane", choices=["FA", "SS"], default=None,
                    help="use the 18 channels of one plane (default: all tower channels)")
     i.add_argument("--channels", default=None, help="comma-separated channels (overrides --plane)")
@@ -395,7 +407,7 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
         description="Train virtual sensors on some OLCs, hide channels of unseen OLCs/seeds (the seed paper's "
                     "scenarios A, B, C or random dropouts), and report R2 and NRMSE per hidden channel (physical and "
-                    "band-passed), the 95 %% interval coverage and the cost per sample.",
+                    "band-passed), the 95 % interval coverage and the cost per sample.",
         epilog="Examples:\n"
                "  fowt-env compare --duration 60                      # paper scenarios A, B, C; hold, kalman, dmd\n"
                "  fowt-env compare --scenario B,random --estimators hold,kalman --seeds 0-2 --json cmp.json\n"
