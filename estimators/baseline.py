@@ -72,26 +72,30 @@ class HoldLastValue:
         """Forget the held values."""
         self._last: np.ndarray | None = None
 
-    def update(self, y: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    def update(self, y: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray:
         """One sample: available channels pass through, lost ones keep their last available value.
 
         Parameters
         ----------
         y : ndarray (n_channels,)
             Measured values (ignored where ``mask`` is False; NaN there is fine).
-        mask : ndarray of bool (n_channels,)
-            True = available. A NaN where mask is True is treated as a dropout.
+        mask : ndarray of bool (n_channels,), optional
+            True = available (default: the finite entries of y). A NaN where mask is True is a dropout.
 
         Returns
         -------
         ndarray (n_channels,)
         """
         y = np.asarray(y, dtype=float)
-        mask = np.asarray(mask, dtype=bool)
+        mask = np.isfinite(y) if mask is None else np.asarray(mask, dtype=bool)
         if y.ndim != 1 or mask.shape != y.shape:
             raise ValueError(f"y and mask must be 1-D of the same length, got {y.shape} and {mask.shape}")
         if not hasattr(self, "_last"):
             self.reset()
+        expected = self._last.size if self._last is not None else getattr(self, "n_channels_", None)
+        if expected is not None and y.size != expected:
+            raise ValueError(f"y must have shape ({expected},) (the channels of this stream/training data), "
+                             f"got {y.shape}")
         if self._last is None:
             if self.fill == "mean":
                 if not hasattr(self, "mean_"):
@@ -105,9 +109,17 @@ class HoldLastValue:
         self._last[ok] = y[ok]
         return self._last.copy()
 
-    def reconstruct(self, Y: np.ndarray, mask: np.ndarray) -> np.ndarray:
-        """A whole record (n_samples, n_channels), identical to streaming :meth:`update`."""
+    def reconstruct(self, Y: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray:
+        """A whole record (n_samples, n_channels), identical to streaming :meth:`update`.
+
+        ``mask`` (n_samples, n_channels) or (n_channels,): True = available; default the finite entries of ``Y``.
+        """
         Y = np.asarray(Y, dtype=float)
-        mask = np.broadcast_to(np.asarray(mask, dtype=bool), Y.shape)
+        if Y.ndim != 2:
+            raise ValueError(f"Y must be 2-D (n_samples, n_channels), got shape {Y.shape}")
+        mask = np.isfinite(Y) if mask is None else np.asarray(mask, dtype=bool)
+        if mask.shape not in (Y.shape, Y.shape[1:]):
+            raise ValueError(f"mask must have the shape of Y {Y.shape} or ({Y.shape[1]},), got {mask.shape}")
+        mask = np.broadcast_to(mask, Y.shape)
         self.reset()
         return np.array([self.update(y, m) for y, m in zip(Y, mask, strict=True)])
