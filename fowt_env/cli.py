@@ -16,6 +16,7 @@ Examples
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import sys
 import time
@@ -289,7 +290,42 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from .compare import SCENARIO_NAMES, SWEEP_INTERVALS, CompareSettings, compare, parse_int_list
+    from .compare import compare
+
+    scenarios, estimators, kwargs = _compare_request(args)
+    with _scheduler(args.scheduler, "compare") as executor:
+        res = compare(scenarios, estimators, executor=executor, **kwargs)
+    print(res.summary())
+    if args.json:
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.json).write_text(json.dumps(res.to_dict(), indent=1))
+        print(f"wrote {args.json}")
+    if args.plot:
+        for path in res.plot(args.plot):
+            print(f"wrote {path}")
+    return 0
+
+
+@contextlib.contextmanager
+def _scheduler(spec: str | None, desc: str):
+    """The executor of ``--scheduler`` (None: none, compare's in-process default), with a progress bar on stderr
+    when it is a terminal."""
+    if spec is None:
+        yield None
+        return
+    from .campaign import ProgressExecutor, parse_scheduler
+
+    with parse_scheduler(spec) as executor:
+        wrapped = ProgressExecutor(executor, desc=desc)
+        try:
+            yield wrapped
+        finally:
+            wrapped.shutdown()
+
+
+def _compare_request(args: argparse.Namespace) -> tuple[list[str], list[str], dict]:
+    """The grid and settings of the compare/campaign arguments: (scenarios, estimators, keyword arguments)."""
+    from .compare import SCENARIO_NAMES, SWEEP_INTERVALS, CompareSettings, parse_int_list
 
     def floats(text: str, name: str) -> list[float]:
         try:
@@ -317,18 +353,39 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         train_cases=tuple(parse_int_list(args.train_cases, "--train-cases")), train_duration=args.train_duration,
         train_seed=args.train_seed, duration=args.duration, plane=None if args.plane == "all" else args.plane,
         dropout_rate=args.dropout_rate, dropout_burst_s=args.dropout_burst, estimator_options=options)
-    res = compare(scenarios, [e.strip() for e in args.estimators.split(",")],
-                  cases=parse_int_list(args.cases, "--cases") if args.cases else None,
-                  seeds=parse_int_list(args.seeds, "--seeds"), update_intervals=intervals, settings=settings,
-                  lyapunov_time=None if lyap == "none" else lyap)
-    print(res.summary())
+    return scenarios, [e.strip() for e in args.estimators.split(",")], {
+        "cases": parse_int_list(args.cases, "--cases") if args.cases else None,
+        "seeds": parse_int_list(args.seeds, "--seeds"), "update_intervals": intervals, "settings": settings,
+        "lyapunov_time": None if lyap == "none" else lyap}
+
+
+def _cmd_campaign(args: argparse.Namespace) -> int:
+    from .campaign import parse_scheduler, run_campaign
+
+    scenarios, estimators, kwargs = _compare_request(args)
+    if args.retries < 0:
+        raise ValueError(f"--retries must be >= 0, got {args.retries}")
+    with parse_scheduler(args.scheduler) as executor:
+        try:
+            done = run_campaign(args.out, scenarios, estimators, executor=executor, retries=args.retries,
+                                progress=args.progress, keep_traces=bool(args.plot), fresh=args.fresh, **kwargs)
+        except KeyboardInterrupt:
+            print(f"fowt-env campaign: interrupted; finished tasks are in {Path(args.out) / 'results.jsonl'}: "
+                  f"run the same command again to resume", file=sys.stderr)
+            return 130
+    print(done.summary())
+    print(f"wrote {done.summary_path}")
     if args.json:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.json).write_text(json.dumps(res.to_dict(), indent=1))
+        Path(args.json).write_text(json.dumps(done.to_dict(), indent=1))
         print(f"wrote {args.json}")
-    if args.plot:
-        for path in res.plot(args.plot):
+    if args.plot and done.result.runs:
+        for path in done.result.plot(args.plot):
             print(f"wrote {path}")
+    if not done.ok:
+        print(f"fowt-env campaign: {len(done.failed)} task(s) failed (listed above and in {done.summary_path}); "
+              f"run the same command again to retry them", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -412,7 +469,8 @@ def build_parser() -> argparse.ArgumentParser:
                "  fowt-env compare --duration 60                      # paper scenarios A, B, C; hold, kalman, dmd\n"
                "  fowt-env compare --scenario B,random --estimators hold,kalman --seeds 0-2 --json cmp.json\n"
                "  fowt-env compare --scenario A --estimators dmd,kalman --update-interval sweep --plot figs\n"
-               "  fowt-env compare --cases 2,5,7 --option dmd.rank=24 --option kalman.gate_sigma=null")
+               "  fowt-env compare --cases 2,5,7 --option dmd.rank=24 --option kalman.gate_sigma=null\n"
+               "  fowt-env compare --cases 2,5 --seeds 0-3 --scenario B --scheduler local:2 --json cmp.json")
     c.add_argument("--scenario", default="A,B,C", help="comma-separated A, B, C, random, or 'all' (default A,B,C)")
     c.add_argument("--cases", default=None,
                    help="test OLCs, e.g. 2,5,7 or 1-12, each under every scenario (default: the paper's pairing "
@@ -438,7 +496,34 @@ def build_parser() -> argparse.ArgumentParser:
                    help="repeatable estimator option (VALUE parsed as JSON if it can be), e.g. dmd.rank=24")
     c.add_argument("--json", default=None, help="write the result as JSON (timings in its 'wall_clock' part)")
     c.add_argument("--plot", default=None, help="folder for the figures")
+    c.add_argument("--scheduler", default=None, metavar="SPEC",
+                   help="run the grid on: serial, threads:N, processes:N, local:N (a Dask LocalCluster of N worker "
+                        "processes) or tcp://HOST:PORT (an existing Dask cluster); the numbers do not depend on it "
+                        "(default: in this process)")
     c.set_defaults(func=_cmd_compare)
+
+    g = sub.add_parser(
+        "campaign", parents=[c], add_help=False, formatter_class=argparse.RawDescriptionHelpFormatter,
+        help="compare's grid as a resumable campaign: results written as tasks finish, retries, Dask clusters",
+        description="Run compare's grid (scenarios x test OLCs x seeds x estimators x update intervals) task by "
+                    "task on any scheduler, appending one JSON line per finished task to OUT/results.jsonl. Run the "
+                    "same command again after an interruption (Ctrl-C, a killed process, a lost cluster) and only "
+                    "the missing tasks run; a task that raises is retried --retries times, then reported as failed "
+                    "(exit code 1), never dropped. The summary, the same JSON as compare --json, goes to "
+                    "OUT/summary.json. Takes every option of compare.",
+        epilog="Examples:\n"
+               "  fowt-env campaign --out camp --cases 2,5 --seeds 0-3 --scenario B --estimators hold,dmd\n"
+               "  fowt-env campaign --out camp --cases 1-12 --seeds 0-9 --scenario all --scheduler local:8\n"
+               "  fowt-env campaign --out camp --cases 1-12 --scheduler tcp://scheduler-host:8786 --retries 2\n"
+               "  fowt-env campaign --out camp --cases 2,5 --seeds 0-5 --scenario B   # rerun: only the new seeds run\n"
+               "  fowt-env campaign --out camp --cases 2,5 --scenario B --fresh       # forget earlier results")
+    g.add_argument("--out", required=True, metavar="DIR",
+                   help="campaign directory: results.jsonl (one line per finished task), summary.json, campaign.json")
+    g.add_argument("--retries", type=int, default=1, help="extra attempts for a task that raises (default 1)")
+    g.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress bar on stderr (default: when stderr is a terminal)")
+    g.add_argument("--fresh", action="store_true", help="forget the results already in --out and start again")
+    g.set_defaults(func=_cmd_campaign)
 
     m = sub.add_parser("modes", help="modal frequencies and damping of the linearised model")
     m.add_argument("--case", default=None, help="OLC number (default: parked, still water)")

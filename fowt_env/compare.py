@@ -49,6 +49,7 @@ import warnings
 from collections import OrderedDict
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Executor
+from contextlib import ContextDecorator
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -69,6 +70,7 @@ __all__ = [
     "clear_cache",
     "compare",
     "fit_sensor",
+    "grid_units",
     "hidden_channels",
     "lyapunov_estimate",
     "parse_int_list",
@@ -356,6 +358,43 @@ class _Memo:
             self._items.clear()
 
 
+class _OneBlasThread(ContextDecorator):
+    """One BLAS thread while the harness computes, so that results do not depend on the executor.
+
+    OpenBLAS splits its reductions between threads, so the last digits of a result depend on how many it uses; Dask
+    workers run with one (``OMP_NUM_THREADS=1``), a plain process with one per core. Reference-counted: units
+    running in several threads at once share one limit, restored when the last one ends. The drivers
+    (:func:`compare`, :func:`fowt_env.campaign.run_campaign`) hold it in the caller's thread while their units run
+    in pool threads: OpenBLAS may ignore a limit set from another thread once its thread count was raised again.
+    """
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._users = 0
+        self._limiter: Any = None
+
+    def __enter__(self) -> _OneBlasThread:
+        from threadpoolctl import threadpool_info, threadpool_limits
+
+        with self._lock:
+            if self._users == 0:
+                self._limiter = threadpool_limits(limits=1, user_api="blas")
+                if any(lib["num_threads"] != 1 for lib in threadpool_info() if lib["user_api"] == "blas"):
+                    warnings.warn("could not limit BLAS to one thread here: results may differ from those of "
+                                  "other executors in the last digits", RuntimeWarning, stacklevel=3)
+            self._users += 1
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        with self._lock:
+            self._users -= 1
+            if self._users == 0:
+                self._limiter.restore_original_limits()
+                self._limiter = None
+
+
+_one_blas_thread = _OneBlasThread()
+
 _TRAIN_DATA = _Memo(2)
 _TEST_DATA = _Memo(8)
 _SENSORS = _Memo(16)
@@ -440,6 +479,7 @@ def _fitted(estimator: str, update_interval: float | None, settings: CompareSett
     return sensor, fit_s
 
 
+@_one_blas_thread
 def fit_sensor(estimator: str, settings: CompareSettings | None = None,
                update_interval: float | None = 1.0) -> Any:
     """The fitted sensor the harness uses (an independent copy), e.g. to run it live in the Gym env.
@@ -609,6 +649,7 @@ def _check_interval(update_interval: Any) -> float:
 
 
 # ------------------------------------------------------------------------------------------------ unit of work
+@_one_blas_thread
 def run_unit(case: int, seed: int, scenario: str, estimator: str, update_interval: float | None,
              settings: CompareSettings) -> dict[str, Any]:
     """One cell of the grid: fit (memoised), reconstruct a test record, score the hidden channels.
@@ -688,6 +729,7 @@ def _trace(truth: np.ndarray, est: np.ndarray, hidden: np.ndarray, rows: list[di
 
 
 # ------------------------------------------------------------------------------------------------ Lyapunov
+@_one_blas_thread
 def lyapunov_estimate(settings: CompareSettings) -> dict[str, Any]:
     """Lyapunov time of the band-passed tower-top fore-aft acceleration of the first training record.
 
@@ -748,6 +790,19 @@ class CompareResult:
     traces: list[dict[str, Any] | None]
     lyapunov: dict[str, Any] | None = None
     total_s: float = float("nan")
+
+    @classmethod
+    def from_outputs(cls, settings: CompareSettings, outputs: Iterable[dict[str, Any]],
+                     lyapunov: dict[str, Any] | None = None, total_s: float = float("nan")) -> CompareResult:
+        """Assemble a result from :func:`run_unit` outputs (in grid order; ``trace`` may be missing or None)."""
+        runs, walls, traces = [], [], []
+        for out in outputs:
+            out = dict(out)
+            wall = out.pop("wall_clock")
+            traces.append(out.pop("trace", None))
+            runs.append(out)
+            walls.append({**{k: out[k] for k in _KEY_FIELDS}, **wall})
+        return cls(settings, runs, walls, traces, lyapunov, total_s)
 
     # ------------------------------------------------------------------------------------------ tables
     def table(self) -> list[dict[str, Any]]:
@@ -1083,6 +1138,7 @@ def _ranges(values: Iterable[int]) -> str:
 
 
 # ------------------------------------------------------------------------------------------------ driver
+@_one_blas_thread  # held in the caller's thread while the units run in pool threads (see _OneBlasThread)
 def compare(
     scenarios: Sequence[str] = ("A", "B", "C"),
     estimators: Sequence[str] = ("hold", "kalman", "dmd"),
@@ -1128,6 +1184,38 @@ def compare(
         Unknown scenario or estimator, an estimator that cannot be imported, a bad OLC number, seed or update
         interval, or a test record that would be a training record.
     """
+    settings = settings if settings is not None else CompareSettings()
+    units = grid_units(scenarios, estimators, cases=cases, seeds=seeds, update_intervals=update_intervals,
+                       settings=settings)
+    lyap = _lyapunov_request(lyapunov_time)
+    t0 = time.perf_counter()
+    if executor is None:
+        outputs = [run_unit(*u) for u in units]
+        if lyap == {}:
+            lyap = lyapunov_estimate(settings)
+    else:
+        futures = [executor.submit(run_unit, *u) for u in units]
+        lyap_future = executor.submit(lyapunov_estimate, settings) if lyap == {} else None
+        outputs = [f.result() for f in futures]
+        if lyap_future is not None:
+            lyap = lyap_future.result()
+    return CompareResult.from_outputs(settings, outputs, lyap, time.perf_counter() - t0)
+
+
+def grid_units(
+    scenarios: Sequence[str] = ("A", "B", "C"),
+    estimators: Sequence[str] = ("hold", "kalman", "dmd"),
+    *,
+    cases: Sequence[int] | None = None,
+    seeds: Sequence[int] = (0,),
+    update_intervals: Sequence[float] = (1.0,),
+    settings: CompareSettings | None = None,
+) -> list[tuple]:
+    """The validated grid of :func:`compare`: ``(case, seed, scenario, estimator, update_interval, settings)``
+    argument tuples of :func:`run_unit`, in result order (scenario, case, seed, estimator, update interval).
+
+    Takes the arguments of :func:`compare` and raises the same errors (ValueError), before any work is done.
+    """
     import surrogates
 
     settings = settings if settings is not None else CompareSettings()
@@ -1164,37 +1252,20 @@ def compare(
                 for est in estimators:
                     for iv in (intervals if _uses_interval(est) else [None]):
                         units.append((case, seed, sc, est, iv, settings))
-    lyap: dict[str, Any] | None
+    return units
+
+
+def _lyapunov_request(lyapunov_time: float | str | None) -> dict[str, Any] | None:
+    """None (no Lyapunov time), ``{}`` (to be computed: :func:`lyapunov_estimate`) or the given one."""
     if lyapunov_time is None or lyapunov_time == "none":
-        lyap = None
-    elif lyapunov_time == "auto":
-        lyap = {}  # computed below
-    else:
-        try:
-            lt = float(lyapunov_time)
-        except (TypeError, ValueError):
-            lt = float("nan")
-        if not (math.isfinite(lt) and lt > 0):
-            raise ValueError(f"lyapunov_time must be a positive number of seconds, 'auto' or None, "
-                             f"got {lyapunov_time!r}")
-        lyap = {"time_s": lt, "source": "given"}
-    t0 = time.perf_counter()
-    if executor is None:
-        outputs = [run_unit(*u) for u in units]
-        if lyap == {}:
-            lyap = lyapunov_estimate(settings)
-    else:
-        futures = [executor.submit(run_unit, *u) for u in units]
-        lyap_future = executor.submit(lyapunov_estimate, settings) if lyap == {} else None
-        outputs = [f.result() for f in futures]
-        if lyap_future is not None:
-            lyap = lyap_future.result()
-    total = time.perf_counter() - t0
-    runs, walls, traces = [], [], []
-    for out in outputs:
-        out = dict(out)
-        wall = out.pop("wall_clock")
-        traces.append(out.pop("trace"))
-        runs.append(out)
-        walls.append({**{k: out[k] for k in _KEY_FIELDS}, **wall})
-    return CompareResult(settings, runs, walls, traces, lyap, total)
+        return None
+    if lyapunov_time == "auto":
+        return {}
+    try:
+        lt = float(lyapunov_time)
+    except (TypeError, ValueError):
+        lt = float("nan")
+    if not (math.isfinite(lt) and lt > 0):
+        raise ValueError(f"lyapunov_time must be a positive number of seconds, 'auto' or None, "
+                         f"got {lyapunov_time!r}")
+    return {"time_s": lt, "source": "given"}
