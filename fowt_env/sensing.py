@@ -258,7 +258,14 @@ def sense(
     std_rec = None if std is None else surrogates.Record(measured.t, np.asarray(std), names, units,
                                                          {**meta, "kind": "std"})
     scores: dict[str, dict[str, float | None]] = {}
-    tr = truth.select(names).y if truth is not None else None
+    tr = None
+    if truth is not None:
+        miss = [c for c in names if c not in truth]
+        if miss:
+            raise ValueError(f"the truth record lacks channels {miss}")
+        tr = truth.select(names).y
+        if tr.shape[0] != y.shape[0]:
+            raise ValueError(f"the truth has {tr.shape[0]} samples, the measurement {y.shape[0]}")
     for j, n in enumerate(names):
         lost = ~mask[:, j]
         if not lost.any():

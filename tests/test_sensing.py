@@ -58,3 +58,21 @@ def test_bad_input_is_a_clear_error(records):
         sense(coarse, "hold")
     with pytest.raises(ValueError, match="no live data"):
         sense(noisy, "hold", hide=surrogates.channels.tower_channels("FA"), train=train)
+
+
+def test_the_sense_command(records, tmp_path, capsys):
+    from fowt_env.cli import main
+    from fowt_env.io import load_record
+
+    noisy, truth, train = records
+    paths = [noisy.save(tmp_path / "run.npz"), truth.save(tmp_path / "truth.npz"), train[0].save(tmp_path / "t.npz")]
+    out = tmp_path / "filled.csv"
+    assert main(["sense", str(paths[0]), "--hide", "TwHt1ALxt,TwHt9MLyt", "--train", str(paths[2]),
+                 "--truth", str(paths[1]), "--out", str(out), "--json", str(tmp_path / "s.json"),
+                 "--plot", str(tmp_path / "fig")]) == 0
+    filled = load_record(out)
+    assert filled.channels == surrogates.channels.tower_channels("FA") and filled.n_samples == noisy.n_samples
+    assert (tmp_path / "fig" / "sensing.png").exists() and "TwHt9MLyt" in capsys.readouterr().out
+    assert main(["sense", str(paths[0]), "--hide", "Nope", "--train", str(paths[2]), "--out",
+                 str(tmp_path / "x.npz")]) == 2
+    assert "not among the sensed channels" in capsys.readouterr().err
