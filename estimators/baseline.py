@@ -22,9 +22,10 @@ class HoldLastValue:
 
     Parameters
     ----------
-    fill : {"zero", "mean"}
-        What to report for a channel lost since the start of a stream: 0.0, or its mean in the training data
-        (needs :meth:`fit`).
+    fill : {"auto", "zero", "mean"}
+        What to report for a channel lost since the start of a stream: its mean in the training data
+        (``"mean"``, needs :meth:`fit`), 0.0 (``"zero"``), or ``"auto"`` (default): the training mean once
+        fitted, else 0.0. (0.0 for a tower-base moment of 5e4 kN m is a poor floor: fit it.)
 
     Examples
     --------
@@ -37,7 +38,7 @@ class HoldLastValue:
     array([5., 2.])
     """
 
-    def __init__(self, fill: str = "zero") -> None:
+    def __init__(self, fill: str = "auto") -> None:
         self.fill = fill
 
     def fit(self, Y: object, mask: object = None) -> HoldLastValue:
@@ -97,14 +98,14 @@ class HoldLastValue:
             raise ValueError(f"y must have shape ({expected},) (the channels of this stream/training data), "
                              f"got {y.shape}")
         if self._last is None:
-            if self.fill == "mean":
-                if not hasattr(self, "mean_"):
-                    raise ValueError("fill='mean' needs fit() first")
+            if self.fill not in ("auto", "zero", "mean"):
+                raise ValueError(f"fill must be 'auto', 'zero' or 'mean', got {self.fill!r}")
+            if self.fill == "mean" and not hasattr(self, "mean_"):
+                raise ValueError("fill='mean' needs fit() first")
+            if self.fill != "zero" and hasattr(self, "mean_"):
                 self._last = self.mean_.astype(float).copy()
-            elif self.fill == "zero":
-                self._last = np.zeros(y.size)
             else:
-                raise ValueError(f"fill must be 'zero' or 'mean', got {self.fill!r}")
+                self._last = np.zeros(y.size)
         ok = mask & np.isfinite(y)
         self._last[ok] = y[ok]
         return self._last.copy()
