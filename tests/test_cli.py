@@ -47,3 +47,18 @@ def test_demo_runs_and_writes_the_figure(tmp_path):
     assert main(["demo", "--duration", "60", "--out", str(tmp_path)]) == 0
     assert (tmp_path / "psd_tower_top_acceleration.png").stat().st_size > 10_000
 
+
+
+def test_discrepancy_command_names_the_hidden_mooring(tmp_path):
+    """The record has catenary mooring, the candidate model linear mooring: the command names the effect."""
+    rec = tmp_path / "measured.npz"
+    assert main(["simulate", "--case", "7", "--duration", "300", "--seed", "4", "--out", str(rec)]) == 0
+    out = tmp_path / "report.json"
+    assert main(["discrepancy", str(rec), "--case", "7", "--model-effects", "mooring_nonlinear=0", "--candidates",
+                 "mooring_nonlinear,rotor_3p", "--seeds", "3", "--json", str(out), "--plot", str(tmp_path)]) == 0
+    report = json.loads(out.read_text())
+    assert report["effect"] == "mooring_nonlinear"
+    assert report["gap_after"] <= 0.5 * report["gap_before"]
+    assert (tmp_path / "discrepancy.png").exists()
+    with pytest.raises(SystemExit, match="load-case number"):  # one line, no traceback
+        main(["discrepancy", str(rec), "--case", "99"])
