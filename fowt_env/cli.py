@@ -370,10 +370,18 @@ def _cmd_compare(args: argparse.Namespace) -> int:
 def _scheduler(spec: str | None, desc: str):
     """The executor of ``--scheduler`` (None: none, compare's in-process default), with a progress bar on stderr
     when it is a terminal."""
+    from .campaign import ProgressExecutor, SerialExecutor, parse_scheduler
+
     if spec is None:
-        yield None
+        if not sys.stderr.isatty():
+            yield None
+            return
+        wrapped = ProgressExecutor(SerialExecutor(), desc=desc)  # same results, a progress bar for people
+        try:
+            yield wrapped
+        finally:
+            wrapped.shutdown()
         return
-    from .campaign import ProgressExecutor, parse_scheduler
 
     with parse_scheduler(spec) as executor:
         wrapped = ProgressExecutor(executor, desc=desc)
