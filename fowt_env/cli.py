@@ -11,6 +11,11 @@ Examples
     fowt-env episode --case 5 --plane FA --fault scenario:A --fault dropout:0.1:2 --duration 120 --out ep.npz
     fowt-env identify olc7.npz --plane FA --json modes.json --plot figs
     fowt-env discrepancy measured.npz --case 7 --model-effects aero_damping=0 --json report.json --plot figs
+    fowt-env identify run.outb --json modes.json            # OpenFAST output (.out/.outb), CSV/Parquet too
+    fowt-env sense olc7.npz --hide TwHt1ALxt,TwHt9MLyt --estimator dmd --out filled.npz --plot figs
+    fowt-env compare --scenario A,B,C --estimators hold,kalman,dmd,koopman --json table.json --plot figs
+    fowt-env compare --estimators dmd --update-interval sweep --plot figs   # where accuracy collapses
+    fowt-env campaign --cases 1-12 --seeds 0-4 --scenario random --out camp --scheduler local:2
 """
 
 from __future__ import annotations
