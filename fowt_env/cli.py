@@ -363,7 +363,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     print(res.summary())
     if args.json:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.json).write_text(json.dumps(res.to_dict(), indent=1))
+        Path(args.json).write_text(json.dumps(res.to_dict(wall_clock=args.timings), indent=1))
         print(f"wrote {args.json}")
     if args.plot:
         for path in res.plot(args.plot):
@@ -599,7 +599,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="seconds, 'auto' (Rosenstein on band-passed tower-top acceleration) or 'none'")
     c.add_argument("--option", action="append", metavar="EST.PARAM=VALUE",
                    help="repeatable estimator option (VALUE parsed as JSON if it can be), e.g. dmd.rank=24")
-    c.add_argument("--json", default=None, help="write the result as JSON (timings in its 'wall_clock' part)")
+    c.add_argument("--json", default=None, help="write the result as JSON (reproducible; --timings adds timings)")
+    c.add_argument("--timings", action="store_true",
+                   help="include the wall-clock timings in the JSON (machine-dependent; without them the JSON is "
+                        "reproducible: the same whatever --scheduler)")
     c.add_argument("--plot", default=None, help="folder for the figures")
     c.add_argument("--scheduler", default=None, metavar="SPEC",
                    help="run the grid on: serial, threads:N, processes:N, local:N (a Dask LocalCluster of N worker "

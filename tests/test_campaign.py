@@ -120,10 +120,15 @@ def test_compare_cli_gives_the_same_json_serially_and_on_a_dask_local_cluster(tm
     assert main([*argv, "--json", str(a)]) == 0
     assert main([*argv, "--json", str(b), "--scheduler", "local:2"]) == 0
     assert "R2 med" in capsys.readouterr().out
-    ja, jb = json.loads(a.read_text()), json.loads(b.read_text())
+    assert a.read_bytes() == b.read_bytes()  # identical files: the JSON holds no wall-clock part by default
+    ja = json.loads(a.read_text())
     assert [r["case"] for r in ja["runs"]] == [2, 2, 5, 5] and ja["lyapunov"]["time_s"] > 0
-    assert without_wall_clock(jb) == without_wall_clock(ja)
-    assert len(jb["wall_clock"]["runs"]) == 4  # the timings are there, apart
+    assert "wall_clock" not in ja
+    c = tmp_path / "c.json"
+    assert main([*argv, "--json", str(c), "--scheduler", "threads:2", "--timings"]) == 0
+    jc = json.loads(c.read_text())
+    assert without_wall_clock(jc) == without_wall_clock(ja)
+    assert len(jc["wall_clock"]["runs"]) == 4  # the timings, on request, apart
 
 
 def test_a_bad_scheduler_is_a_one_line_cli_error(capsys):
