@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from sensor_scenarios import PAPER_TRAIN, hidden_b_mask, scenario_record  # tests/ is on sys.path (pytest prepend mode)
 
 from estimators import NotFittedError
 from estimators.dmd_sensor import HankelDMDSensor
@@ -99,17 +100,9 @@ def test_bad_input_gives_clear_errors():
 
 
 # ------------------------------------------------------------------------------ the surrogate (OC3 spar, FA)
-SCENARIOS = {"A": (5, (2, 3, 5, 7, 11, 12, 14, 16)), "B": (7, (0, 8, 9, 17)), "C": (2, (0, 8, 9, 17))}
-PAPER_TRAIN = (1, 3, 4, 6, 8, 9, 10, 11, 12)
-
-
 def scenario_r2(surrogates, model, sensor, name: str, duration: float, seed: int = 7) -> np.ndarray:
-    case, hidden = SCENARIOS[name]
-    noisy, truth = surrogates.simulate(model, case, duration=duration, seed=seed, return_truth=True)
-    y, t = noisy.planar("FA").y, truth.planar("FA").y
-    mask = np.ones(18, dtype=bool)
-    mask[list(hidden)] = False
-    return r2_score(t, sensor.reconstruct(np.where(mask, y, np.nan), mask))[list(hidden)]
+    y, t, mask, hidden = scenario_record(surrogates, model, name, duration, seed)
+    return r2_score(t, sensor.reconstruct(np.where(mask, y, np.nan), mask))[hidden]
 
 
 @pytest.fixture(scope="module")
@@ -147,12 +140,6 @@ def test_accuracy_falls_with_the_update_interval(spar):
     assert scores[DT] > 0.995
     assert scores[DT] >= scores[0.25] >= scores[1.0] >= scores[4.0]
     assert scores[4.0] < scores[0.25] - 0.01
-
-
-def hidden_b_mask(n: int) -> np.ndarray:
-    mask = np.ones((n, 18), dtype=bool)
-    mask[:, [0, 8, 9, 17]] = False
-    return mask
 
 
 def test_nan_in_live_channels_is_a_dropout(spar):

@@ -10,6 +10,13 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 from scipy.signal import lfilter
+from sensor_scenarios import (  # tests/ is on sys.path (pytest prepend mode)
+    PAPER_TRAIN,
+    check_spikes_are_gated,
+    check_stuck_sensor_is_rejected,
+    hidden_b_mask,
+    scenario_record,
+)
 
 import estimators.kalman
 from estimators.baseline import HoldLastValue
@@ -372,10 +379,6 @@ def test_fit_with_missing_training_samples_and_a_tuple_system(oscillator):
 
 
 # ------------------------------------------------------------------------------ the surrogate (OC3 spar, FA)
-SCENARIOS = {"A": (5, (2, 3, 5, 7, 11, 12, 14, 16)), "B": (7, (0, 8, 9, 17)), "C": (2, (0, 8, 9, 17))}
-PAPER_TRAIN = (1, 3, 4, 6, 8, 9, 10, 11, 12)
-
-
 def fit_surrogate_sensor(surrogates, model, cases, duration, **kwargs) -> KalmanSensor:
     # every OLC runs at 12 m/s and 12.1 rpm: one linearisation (here at OLC 7's operating point) serves all
     sys = model.linearize(surrogates.load_case(7), plane="FA")
@@ -384,13 +387,8 @@ def fit_surrogate_sensor(surrogates, model, cases, duration, **kwargs) -> Kalman
 
 
 def scenario_scores(surrogates, model, sensor, name, duration, seed=7):
-    case, hidden = SCENARIOS[name]
-    noisy, truth = surrogates.simulate(model, case, duration=duration, seed=seed, return_truth=True)
-    y, t = noisy.planar("FA").y, truth.planar("FA").y
-    mask = np.ones(18, dtype=bool)
-    mask[list(hidden)] = False
+    y, t, mask, h = scenario_record(surrogates, model, name, duration, seed)
     est, std = sensor.reconstruct(np.where(mask, y, np.nan), mask, return_std=True)
-    h = list(hidden)
     cover = np.mean(np.abs(t - est) <= 1.96 * std, axis=0)
     return r2(t, est)[h], nrmse(t, est)[h], cover[h]
 
@@ -412,12 +410,6 @@ def test_scenario_b_on_surrogate_data(spar):
     assert np.median(r2_h) >= 0.95 and r2_h.min() >= 0.85  # the issue's target
     assert np.median(r2_h) >= 0.999 and r2_h.min() >= 0.995  # what the sensor reaches, with margin
     assert np.all(nrmse_h < 0.02)
-
-
-def hidden_b_mask(n: int) -> np.ndarray:
-    mask = np.ones((n, 18), dtype=bool)
-    mask[:, [0, 8, 9, 17]] = False
-    return mask
 
 
 def test_nan_in_live_channels_is_a_dropout(spar):
@@ -464,33 +456,12 @@ def test_mask_changing_every_sample(spar):
 
 def test_spikes_are_gated(spar):
     _, _, sensor, y, truth = spar
-    mask = hidden_b_mask(y.shape[0])
-    rng = np.random.default_rng(7)
-    spikes = (rng.random(y.shape) < 0.005) & mask
-    y_spiky = y + spikes * rng.choice([-1.0, 1.0], size=y.shape) * 30.0 * sensor.scale_
-    hidden = [0, 8, 9, 17]
-    clean = r2(truth, sensor.reconstruct(y, mask))[hidden]
-    gated = r2(truth, sensor.reconstruct(y_spiky, mask))[hidden]
-    assert sensor.n_gated_ >= 0.9 * spikes.sum()
-    ungated_sensor = copy.deepcopy(sensor)
-    ungated_sensor.gate_sigma = None
-    ungated = r2(truth, ungated_sensor.reconstruct(y_spiky, mask))[hidden]
-    assert ungated_sensor.n_gated_ == 0
-    print(f"\nspikes on 0.5% of live samples: hidden R2 clean {np.round(clean, 4)}, gated {np.round(gated, 4)}, "
-          f"ungated {np.round(ungated, 4)}")
-    assert np.all(gated > clean - 0.002)
-    assert np.all(ungated < gated)
+    check_spikes_are_gated(sensor, y, truth)
 
 
 def test_stuck_sensor_is_rejected(spar):
     _, _, sensor, y, truth = spar
-    mask = hidden_b_mask(y.shape[0])
-    y_stuck = y.copy()
-    y_stuck[800:, 4] = y[800, 4]  # gauge-5 accelerometer frozen from t = 10 s, still reported available
-    est = sensor.reconstruct(y_stuck, mask)
-    assert np.all(np.isfinite(est))
-    assert sensor.gated_counts_[4] > 0.5 * (y.shape[0] - 800)
-    assert r2(truth, est)[[0, 8, 9, 17]].min() > 0.99
+    check_stuck_sensor_is_rejected(sensor, y, truth)
 
 
 def test_wrong_channel_count_on_the_surrogate_model(spar):

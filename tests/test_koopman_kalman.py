@@ -10,6 +10,15 @@ import time
 import numpy as np
 import pytest
 import scipy.linalg as sla
+from sensor_scenarios import (  # tests/ is on sys.path (pytest prepend mode)
+    HIDDEN_B,
+    PAPER_TRAIN,
+    SCENARIOS,
+    check_spikes_are_gated,
+    check_stuck_sensor_is_rejected,
+    hidden_b_mask,
+    scenario_record,
+)
 
 import estimators.koopman_kalman
 from estimators.baseline import HoldLastValue
@@ -283,9 +292,6 @@ def test_fit_with_missing_training_samples_and_a_list_of_records(oscillator):
 
 # ------------------------------------------------------------------------------ the surrogate (OC3 spar, FA)
 SURROGATE_DT = 0.0125  # s (80 Hz)
-SCENARIOS = {"A": (5, (2, 3, 5, 7, 11, 12, 14, 16)), "B": (7, (0, 8, 9, 17)), "C": (2, (0, 8, 9, 17))}
-PAPER_TRAIN = (1, 3, 4, 6, 8, 9, 10, 11, 12)
-HIDDEN_B = [0, 8, 9, 17]
 
 
 def fit_surrogate_sensor(surrogates, model, cases, duration, **kwargs) -> KoopmanKalmanSensor:
@@ -294,13 +300,8 @@ def fit_surrogate_sensor(surrogates, model, cases, duration, **kwargs) -> Koopma
 
 
 def scenario_scores(surrogates, model, sensor, name, duration, seed=7, return_errors=False):
-    case, hidden = SCENARIOS[name]
-    noisy, truth = surrogates.simulate(model, case, duration=duration, seed=seed, return_truth=True)
-    y, t = noisy.planar("FA").y, truth.planar("FA").y
-    mask = np.ones(18, dtype=bool)
-    mask[list(hidden)] = False
+    y, t, mask, h = scenario_record(surrogates, model, name, duration, seed)
     est, std = sensor.reconstruct(np.where(mask, y, np.nan), mask, return_std=True)
-    h = list(hidden)
     cover = np.mean(np.abs(t - est) <= 1.96 * std, axis=0)
     if return_errors:
         return r2_score(t, est)[h], nrmse(t, est)[h], cover[h], (np.abs(t - est)[:, h], std[:, h])
@@ -314,12 +315,6 @@ def spar():
     sensor = fit_surrogate_sensor(surrogates, model, (1, 6, 11), duration=200.0, em_iter=5)
     noisy, truth = surrogates.simulate(model, 7, duration=60.0, seed=21, return_truth=True)
     return surrogates, model, sensor, noisy.planar("FA").y, truth.planar("FA").y
-
-
-def hidden_b_mask(n: int) -> np.ndarray:
-    mask = np.ones((n, 18), dtype=bool)
-    mask[:, HIDDEN_B] = False
-    return mask
 
 
 def test_scenario_b_on_surrogate_data(spar):
@@ -386,32 +381,12 @@ def test_mask_changing_every_sample(spar):
 
 def test_spikes_are_gated(spar):
     _, _, sensor, y, truth = spar
-    mask = hidden_b_mask(y.shape[0])
-    rng = np.random.default_rng(7)
-    spikes = (rng.random(y.shape) < 0.005) & mask
-    y_spiky = y + spikes * rng.choice([-1.0, 1.0], size=y.shape) * 30.0 * sensor.scale_
-    clean = r2_score(truth, sensor.reconstruct(y, mask))[HIDDEN_B]
-    gated = r2_score(truth, sensor.reconstruct(y_spiky, mask))[HIDDEN_B]
-    assert sensor.n_gated_ >= 0.9 * spikes.sum()
-    ungated_sensor = copy.deepcopy(sensor)
-    ungated_sensor.gate_sigma = None
-    ungated = r2_score(truth, ungated_sensor.reconstruct(y_spiky, mask))[HIDDEN_B]
-    assert ungated_sensor.n_gated_ == 0
-    print(f"\nspikes on 0.5% of live samples: hidden R2 clean {np.round(clean, 5)}, gated {np.round(gated, 5)}, "
-          f"ungated {np.round(ungated, 5)}")
-    assert np.all(gated > clean - 0.002)
-    assert np.all(ungated < gated)
+    check_spikes_are_gated(sensor, y, truth)
 
 
 def test_stuck_sensor_is_rejected(spar):
     _, _, sensor, y, truth = spar
-    mask = hidden_b_mask(y.shape[0])
-    y_stuck = y.copy()
-    y_stuck[800:, 4] = y[800, 4]  # gauge-5 accelerometer frozen from t = 10 s, still reported available
-    est = sensor.reconstruct(y_stuck, mask)
-    assert np.all(np.isfinite(est))
-    assert sensor.gated_counts_[4] > 0.5 * (y.shape[0] - 800)
-    assert r2_score(truth, est)[HIDDEN_B].min() > 0.99
+    check_stuck_sensor_is_rejected(sensor, y, truth)
 
 
 def test_wrong_channel_count_on_the_surrogate_model(spar):
