@@ -21,8 +21,6 @@ from typing import Any
 
 import numpy as np
 
-from estimators.metrics import nrmse, r2_score
-
 __all__ = ["SensingResult", "sense"]
 
 
@@ -44,6 +42,8 @@ class SensingResult:
         (normalised by the variance and range of the whole truth record).
     timing : dict
         ``fit_s``, ``reconstruct_s``, ``us_per_sample`` (wall clock).
+    measured : ndarray (n_samples, n_channels) or None
+        The measured values of the sensed channels (channel units), for the figure.
     """
 
     record: Any
@@ -52,6 +52,7 @@ class SensingResult:
     estimator: str
     scores: dict[str, dict[str, float | None]] = field(default_factory=dict)
     timing: dict[str, float] = field(default_factory=dict)
+    measured: np.ndarray | None = None
 
     def summary(self) -> str:
         """Readable table of the lost channels (fraction lost, R² and NRMSE if a truth was given)."""
@@ -114,8 +115,8 @@ class SensingResult:
             est = self.record.y[:, j]
             if truth is not None and name in truth:
                 ax.plot(t[sel], truth[name][sel], color="k", lw=1.2, label="truth")
-            meas = np.where(live, self._measured[:, j], np.nan) if hasattr(self, "_measured") else None
-            if meas is not None:
+            if self.measured is not None:
+                meas = np.where(live, self.measured[:, j], np.nan)
                 ax.plot(t[sel], meas[sel], color="0.6", lw=0.8, label="measured (live)")
             ax.plot(t[sel], est[sel], color="C1", lw=1.0, label=f"{self.estimator} estimate")
             if self.std is not None:
@@ -201,7 +202,7 @@ def sense(
     """
     import surrogates
 
-    from .compare import ESTIMATORS, CompareSettings, fit_sensor
+    from .compare import ESTIMATORS, CompareSettings, _hidden_scores, fit_sensor
 
     if estimator not in ESTIMATORS:
         raise ValueError(f"unknown estimator {estimator!r}; choose from {sorted(ESTIMATORS)}")
@@ -271,19 +272,12 @@ def sense(
         if not lost.any():
             continue
         s: dict[str, float | None] = {"lost_fraction": float(lost.mean()), "r2": None, "nrmse": None}
-        if tr is not None:
-            e = est[lost, j] - tr[lost, j]
-            sst = float(np.sum((tr[:, j] - tr[:, j].mean()) ** 2)) * lost.mean()
-            rng = float(np.ptp(tr[:, j]))
-            s["r2"] = float(1.0 - np.sum(e**2) / sst) if sst > 0 else None
-            s["nrmse"] = float(np.sqrt(np.mean(e**2)) / rng) if rng > 0 else None
-            if lost.all():  # the paper's definitions on whole records
-                s["r2"], s["nrmse"] = float(r2_score(tr[:, j], est[:, j])), float(nrmse(tr[:, j], est[:, j]))
+        if tr is not None:  # over the lost samples, normalised by the whole truth record (as compare scores)
+            s["r2"], s["nrmse"] = _hidden_scores(tr[:, j], est[:, j], lost)
         scores[n] = s
-    res = SensingResult(rec, std_rec, mask, estimator, scores,
-                        {"fit_s": fit_s, "reconstruct_s": wall, "us_per_sample": 1e6 * wall / max(len(y), 1)})
-    res._measured = y  # for the figure
-    return res
+    return SensingResult(rec, std_rec, mask, estimator, scores,
+                         {"fit_s": fit_s, "reconstruct_s": wall, "us_per_sample": 1e6 * wall / max(len(y), 1)},
+                         measured=y)
 
 
 def write_json(result: SensingResult, path: str | Path) -> Path:
