@@ -239,6 +239,14 @@ def _stats_table(rec, names: list[str]) -> str:
     return "\n".join(rows)
 
 
+def _option_value(text: str):
+    """The VALUE of an ``--option ...=VALUE``: parsed as JSON if it can be (numbers, true, lists), else the text."""
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError:
+        return text
+
+
 def _cmd_sense(args: argparse.Namespace) -> int:
     from .compare import CompareSettings, parse_int_list
     from .io import save_record
@@ -252,10 +260,7 @@ def _cmd_sense(args: argparse.Namespace) -> int:
         key, eq, value = spec.partition("=")
         if not (eq and key):
             raise ValueError(f"--option: expected PARAM=VALUE, got {spec!r}")
-        try:
-            options[key] = json.loads(value)
-        except json.JSONDecodeError:
-            options[key] = value
+        options[key] = _option_value(value)
     settings = None
     if not train:
         settings = CompareSettings(train_cases=tuple(parse_int_list(args.train_cases, "--train-cases")),
@@ -415,11 +420,7 @@ def _compare_request(args: argparse.Namespace) -> tuple[list[str], list[str], di
         est, dot, param = key.partition(".")
         if not (eq and dot and est and param):
             raise ValueError(f"--option: expected ESTIMATOR.PARAM=VALUE, got {spec!r}")
-        try:
-            parsed = json.loads(value)
-        except json.JSONDecodeError:
-            parsed = value
-        options.setdefault(est, {})[param] = parsed
+        options.setdefault(est, {})[param] = _option_value(value)
     lyap = args.lyapunov_time if args.lyapunov_time in ("auto", "none") else floats(args.lyapunov_time,
                                                                                     "lyapunov-time")[0]
     settings = CompareSettings(
