@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .validation import as_records
+from .validation import apply_masks, as_records
 
 __all__ = ["HoldLastValue"]
 
@@ -48,22 +48,16 @@ class HoldLastValue:
         ----------
         Y : array_like (n_samples, n_channels) or list of such records
             Training data (channel units); NaN marks missing samples.
-        mask : array_like of bool, shape of ``Y`` (a list like ``Y`` for a list), optional
-            False marks further missing samples.
+        mask : array_like of bool or list of them, optional
+            False marks further missing samples: one mask for all records or one per record, each of the
+            record's shape or ``(n_channels,)`` (:func:`estimators.validation.apply_masks`).
 
         Returns
         -------
         self
         """
-        records = as_records(Y, "Y", allow_nan=True, min_samples=1)
-        if mask is None:
-            masks = [np.ones(r.shape, dtype=bool) for r in records]
-        else:
-            masks = [np.asarray(m, dtype=bool) for m in (mask if isinstance(mask, (list, tuple)) else [mask])]
-            if len(masks) != len(records) or any(m.shape != r.shape for m, r in zip(masks, records, strict=True)):
-                raise ValueError("mask must have the shape of Y (a list of the same shapes for a list of records)")
-        Y = np.concatenate(records, axis=0)
-        m = np.concatenate(masks, axis=0) & np.isfinite(Y)
+        Y = np.concatenate(apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=1), mask), axis=0)
+        m = np.isfinite(Y)
         counts = m.sum(axis=0)
         self.mean_ = np.where(counts > 0, np.where(m, Y, 0.0).sum(axis=0) / np.maximum(counts, 1), 0.0)
         self.n_channels_ = Y.shape[1]

@@ -37,7 +37,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .hankel_dmd import HankelDMD
-from .validation import as_2d_float, as_records, check_fitted, check_number
+from .validation import apply_masks, as_2d_float, as_records, check_fitted, check_number
 
 __all__ = ["HankelDMDSensor"]
 
@@ -155,8 +155,10 @@ class HankelDMDSensor:
         ----------
         Y : array_like (n_samples, n_channels) or list of such records
             Training data in channel units; NaN marks missing samples.
-        mask : array_like of bool, same shape as ``Y`` (or a list like ``Y``), optional
-            False marks further missing samples. Records are split at missing samples (no Hankel column spans
+        mask : array_like of bool or list of them, optional
+            False marks further missing samples: one mask for all records or one per record, each of the
+            record's shape or ``(n_channels,)`` (:func:`estimators.validation.apply_masks`).
+            Records are split at missing samples (no Hankel column spans
             a gap).
 
         Returns
@@ -170,13 +172,8 @@ class HankelDMDSensor:
             check_number("gate_sigma", self.gate_sigma, positive=True)
         if not isinstance(self.causal, (bool, np.bool_)):
             raise ValueError(f"causal must be True or False, got {self.causal!r}")
-        records = as_records(Y, "Y", allow_nan=True, min_samples=2)
+        records = apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=2), mask)
         p = records[0].shape[1]
-        if mask is not None:
-            masks = [np.asarray(m) for m in mask] if isinstance(mask, (list, tuple)) else [np.asarray(mask)]
-            if len(masks) != len(records) or any(m.shape != r.shape for m, r in zip(masks, records, strict=True)):
-                raise ValueError("mask must have the shape of Y (a list of the same shapes for a list of records)")
-            records = [np.where(m.astype(bool), r, np.nan) for m, r in zip(masks, records, strict=True)]
         finite = np.concatenate(records, axis=0)
         ok = np.isfinite(finite)
         counts = ok.sum(axis=0)

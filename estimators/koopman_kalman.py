@@ -89,7 +89,7 @@ from scipy.linalg.lapack import dtrtri as _dtrtri
 from scipy.signal import lfilter
 
 from .hankel_dmd import HankelDMD
-from .validation import NotFittedError, as_records, check_int, check_number, split_at_nonfinite
+from .validation import NotFittedError, apply_masks, as_records, check_int, check_number, split_at_nonfinite
 
 __all__ = ["KoopmanKalmanSensor"]
 
@@ -306,7 +306,7 @@ class KoopmanKalmanSensor:
             channel; no complete stretch long enough for the delay window; a rank too large for the data.
         """
         dt, _ = self._check_params()
-        records = _apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=1), mask)
+        records = apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=1), mask)
         p = records[0].shape[1]
         finite = [np.isfinite(r) for r in records]
         counts = np.sum([f.sum(axis=0) for f in finite], axis=0)
@@ -816,26 +816,6 @@ class KoopmanKalmanSensor:
 
 
 # ------------------------------------------------------------------------------------------------- helpers
-def _apply_masks(records: list[np.ndarray], mask: object) -> list[np.ndarray]:
-    """Records with NaN where the mask (one per record, or one for all) is False."""
-    if mask is None:
-        return records
-    if isinstance(mask, (list, tuple)) and len(mask) > 0 and not np.isscalar(mask[0]) and np.ndim(mask[0]) >= 1 \
-            and len(records) > 1:
-        masks = list(mask)
-        if len(masks) != len(records):
-            raise ValueError(f"mask: a list of {len(masks)} masks for {len(records)} records")
-    else:
-        masks = [mask] * len(records)
-    out = []
-    for i, (rec, m) in enumerate(zip(records, masks, strict=True)):
-        m = np.asarray(m)
-        if m.shape not in (rec.shape, (rec.shape[1],)):
-            raise ValueError(f"mask: record {i} needs shape {rec.shape} or ({rec.shape[1]},), got {m.shape}")
-        out.append(np.where(np.broadcast_to(m.astype(bool), rec.shape), rec, np.nan))
-    return out
-
-
 def _resolve_delays(delays: object, dt: float | None) -> int:
     """Delay depth in samples from an int (samples) or a float (seconds, needs dt)."""
     if isinstance(delays, Integral) and not isinstance(delays, bool):

@@ -13,6 +13,7 @@ import numpy as np
 
 __all__ = [
     "NotFittedError",
+    "apply_masks",
     "as_2d_float",
     "as_records",
     "check_fitted",
@@ -329,3 +330,40 @@ def check_fitted(estimator: object, attributes: str | Sequence[str]) -> None:
     attrs = [attributes] if isinstance(attributes, str) else list(attributes)
     if not all(hasattr(estimator, a) for a in attrs):
         raise NotFittedError(f"this {type(estimator).__name__} is not fitted yet: call fit() first")
+
+
+def apply_masks(records: list[np.ndarray], mask: object) -> list[np.ndarray]:
+    """Training records with NaN where their mask is False (the virtual sensors' ``fit(Y, mask)``).
+
+    Parameters
+    ----------
+    records : list of ndarray (n_samples, n_channels)
+    mask : array_like of bool or list of them, optional
+        One mask for all records or one per record, each of a record's shape or ``(n_channels,)``; None: none.
+
+    Returns
+    -------
+    list of ndarray
+        New arrays (the inputs are not modified); the records themselves when ``mask`` is None.
+
+    Raises
+    ------
+    ValueError
+        A list of masks of the wrong length, or a mask of the wrong shape (record index named).
+    """
+    if mask is None:
+        return records
+    if isinstance(mask, (list, tuple)) and len(mask) > 0 and not np.isscalar(mask[0]) and np.ndim(mask[0]) >= 1 \
+            and (len(records) > 1 or np.ndim(mask[0]) == 2):
+        masks = list(mask)
+        if len(masks) != len(records):
+            raise ValueError(f"mask: a list of {len(masks)} masks for {len(records)} records")
+    else:
+        masks = [mask] * len(records)
+    out = []
+    for i, (rec, m) in enumerate(zip(records, masks, strict=True)):
+        m = np.asarray(m)
+        if m.shape not in (rec.shape, (rec.shape[1],)):
+            raise ValueError(f"mask: record {i} needs shape {rec.shape} or ({rec.shape[1]},), got {m.shape}")
+        out.append(np.where(np.broadcast_to(m.astype(bool), rec.shape), rec, np.nan))
+    return out

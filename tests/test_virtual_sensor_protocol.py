@@ -91,3 +91,16 @@ def test_wrong_channel_count_is_a_clear_error(fitted, data):
         sensor.update(y[0, :3], np.ones(3, dtype=bool))
     with pytest.raises(ValueError, match="shape|channels"):
         sensor.reconstruct(np.hstack([y, y[:, :1]]), np.ones((y.shape[0], 5), dtype=bool))
+
+
+@pytest.mark.parametrize("name", sorted(SENSORS))
+def test_a_training_mask_is_the_same_as_nan_in_the_training_data(name, data):
+    sys, train, y, _ = data
+    masks = [np.ones(r.shape, dtype=bool) for r in train]  # one mask per record: a sensor lost for 2.5 s in each
+    masks[0][3000:3200, 2] = False
+    masks[1][5000:5200, 1] = False  # channel 1 is the one reconstructed below
+    with_mask = SENSORS[name](sys).fit(train, mask=masks)
+    with_nan = SENSORS[name](sys).fit([np.where(m, r, np.nan) for m, r in zip(masks, train, strict=True)])
+    live = np.ones(y.shape, dtype=bool)
+    live[:, 1] = False
+    np.testing.assert_array_equal(with_mask.reconstruct(y, live), with_nan.reconstruct(y, live), err_msg=name)
