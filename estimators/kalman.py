@@ -52,6 +52,8 @@ from scipy.linalg.lapack import dpotrf as _dpotrf
 from scipy.linalg.lapack import dtrtri as _dtrtri
 from scipy.signal import lfilter
 
+from .intervals import model_error_std, unmeasured_std
+
 __all__ = ["KalmanSensor"]
 
 _DIFF_ORDER = 4  # order of the differences that measure the white-noise floor
@@ -161,14 +163,19 @@ class KalmanSensor:
         prediction: no channel live (mask False or NaN everywhere), or every live one rejected by the gate.
     std_ : ndarray (n_channels,)
         Standard deviation of the latest estimate of each channel's true (noise-free) value (channel units): the
-        filter's, times :attr:`interval_scale_` for the channels not used at that sample (hidden, lost, gated).
+        filter's for the channels used at that sample; for the others (hidden, lost, gated) the filter's combined
+        with :attr:`model_error_std_` as ``sqrt(s^2 + model_error_std_^2)`` (see :mod:`estimators.intervals`).
     interval_scale_ : ndarray (n_channels,)
-        Calibration factor (>= 1) on the standard deviation of each channel when it is not measured, learned by
-        :meth:`fit` (ones with ``calibrate=False``).
+        Calibration factor (>= 1) on the standard deviation of each channel when it alone is not measured,
+        learned by :meth:`fit` (ones with ``calibrate=False``); read at :meth:`reset`.
+    model_error_std_ : ndarray (n_channels,)
+        Standard deviation of the error the model does not know about, per channel (channel units):
+        ``sqrt(interval_scale_^2 - 1)`` times ``calibration_["loo_std"]``.
     calibration_ : dict
         How the calibration was made: ``held_out`` (True if on training samples the likelihood did not use,
-        False if on all of them), ``n_samples`` (samples per channel compared) and ``raw_scale`` (the factors
-        before they are kept >= 1; ones when no calibration was made).
+        False if on all of them), ``n_samples`` (samples per channel compared), ``raw_scale`` (the factors
+        before they are kept >= 1; ones when no calibration was made) and ``loo_std`` (the filter's steady-state
+        standard deviation of each channel with every other channel measured, channel units).
     input_estimate_ : ndarray (n_unknown,)
         Latest estimate of the unknown loads (input units; deviations from the operating point).
 
@@ -194,9 +201,11 @@ class KalmanSensor:
 
     The noise model is white: slowly varying (coloured) sensor errors and the model's own errors are read as
     structural response, which makes the filter's standard deviations of unmeasured channels optimistic. The
-    calibration of :meth:`fit` widens them by a factor per channel (:attr:`interval_scale_`), learned with every
-    other channel live and applied to whatever set of channels is lost, which transfers well: on the surrogate the
-    factors needed by scenarios with 4 and 8 hidden channels are within about 15 % of the leave-one-out ones.
+    calibration of :meth:`fit` measures by how much, per channel, with every other channel live
+    (:attr:`interval_scale_`), and adds the missing part as a variance of its own (:attr:`model_error_std_`) to the
+    filter's variance of whatever set of channels is lost: the unmodelled error does not grow with the number of
+    lost channels the way the filter's does, and scaling the filter's standard deviation instead made the
+    intervals of scenarios with 4-8 lost channels too wide (see :mod:`estimators.intervals`).
     Its weak point is that the measurement noise of the channel itself has to be taken out of the comparison
     (see :meth:`_calibrate`): where that noise is several times the estimation error, the factor of a channel
     is only known to some 10-30 %. Channels used at a sample keep the filter's standard deviation.
@@ -450,10 +459,10 @@ class KalmanSensor:
         self.known_inputs_ = [self._in_names[i] for i in self._ik]
         self._prepare()
         self.interval_scale_ = np.ones(n_ch)
-        self.calibration_ = {"held_out": False, "n_samples": 0, "raw_scale": np.ones(n_ch)}
+        self.calibration_ = {"held_out": False, "n_samples": 0, "raw_scale": np.ones(n_ch),
+                             "loo_std": np.zeros(n_ch)}
         if self.calibrate:
             self._calibrate(records)
-        self._std_scale = self.scale_ * self.interval_scale_
         self.reset()
         return self
 
@@ -483,6 +492,7 @@ class KalmanSensor:
         stretches = [((seg - self.mean_) / self.scale_, k0) for seg, k0 in stretches]
         n_eval = sum(seg.shape[0] - k0 for seg, k0 in stretches)
         raw = np.ones(n_ch)
+        loo_var = np.zeros(n_ch)
         if n_eval >= _MIN_SEGMENT and n_ch > 1:
             for i in range(n_ch):
                 live = np.arange(n_ch) != i
@@ -498,6 +508,7 @@ class KalmanSensor:
                 gain = pp @ h.T @ ui @ ui.T
                 pf = pp - gain @ h @ pp
                 s2 = float(h_all[i] @ pf @ h_all[i])
+                loo_var[i] = max(s2, 0.0)
                 hi_gain = h_all[i] @ gain
                 fk = f @ gain
                 a_cl = f - fk @ h
@@ -513,7 +524,13 @@ class KalmanSensor:
                 if s2 > 0 and math.isfinite(c2):
                     raw[i] = math.sqrt(max((c2 - r[i]) / s2, 0.0))
         self.interval_scale_ = np.maximum(raw, 1.0)
-        self.calibration_ = {"held_out": held_out, "n_samples": n_eval, "raw_scale": raw}
+        self.calibration_ = {"held_out": held_out, "n_samples": n_eval, "raw_scale": raw,
+                             "loo_std": np.sqrt(loo_var) * self.scale_}
+
+    @property
+    def model_error_std_(self) -> np.ndarray:
+        """Standard deviation of the unmodelled error of each channel (channel units), from the calibration."""
+        return model_error_std(self.interval_scale_, self.calibration_["loo_std"])
 
     def _initial_cov(self, model: dict, q_ff: np.ndarray) -> np.ndarray:
         """Covariance of the state at the start of a stream: the stationary covariance of the model with AR(1)
@@ -690,7 +707,13 @@ class KalmanSensor:
         self.n_gated_ = 0
         self.gated_counts_ = np.zeros(self.n_channels_, dtype=int)
         self.n_blind_ = 0
-        self.std_ = np.sqrt(np.einsum("ij,jk,ik->i", self._H, self._P, self._H)) * self._std_scale
+        scale = np.asarray(self.interval_scale_, dtype=float)
+        if scale.shape != (self.n_channels_,) or not np.all((scale > 0) & np.isfinite(scale)):
+            raise ValueError(f"interval_scale_ must hold {self.n_channels_} positive finite factors, got {scale!r}")
+        self._k = scale.copy()
+        self._err_std = model_error_std(scale, self.calibration_["loo_std"])
+        self.std_ = unmeasured_std(
+            np.sqrt(np.einsum("ij,jk,ik->i", self._H, self._P, self._H)) * self.scale_, self._k, self._err_std)
         self.input_estimate_ = np.zeros(len(self._iu))
 
     def _rows_for(self, live: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -793,9 +816,10 @@ class KalmanSensor:
             hx = hx + self._Dk @ uk
         est = self.mean_ + self.scale_ * hx
         hp = self._H @ p
-        std_scale = self._std_scale.copy()
-        std_scale[idx] = self.scale_[idx]  # channels used at this sample: the filter's own uncertainty
-        self.std_ = np.sqrt(np.maximum((hp * self._H).sum(axis=1), 0.0)) * std_scale
+        own = np.sqrt(np.maximum((hp * self._H).sum(axis=1), 0.0)) * self.scale_
+        std = unmeasured_std(own, self._k, self._err_std)
+        std[idx] = own[idx]  # channels used at this sample: the filter's own uncertainty
+        self.std_ = std
         self.input_estimate_ = x[self._n:] * self._unscale_f
         # predict to the next sample
         xn = self._F @ x

@@ -89,6 +89,7 @@ from scipy.linalg.lapack import dtrtri as _dtrtri
 from scipy.signal import lfilter
 
 from .hankel_dmd import HankelDMD
+from .intervals import model_error_std, unmeasured_std
 from .validation import NotFittedError, apply_masks, as_records, check_int, check_number, split_at_nonfinite
 
 __all__ = ["KoopmanKalmanSensor"]
@@ -189,15 +190,21 @@ class KoopmanKalmanSensor:
         Samples since :meth:`reset` at which no channel was used (none live, or every live one gated): the
         estimate is the model's prediction.
     std_ : ndarray (n_channels,)
-        Standard deviation of the latest estimate of each channel's noise-free value (channel units): the filter's,
-        times :attr:`interval_scale_` for the channels not used at that sample (hidden, lost, gated).
+        Standard deviation of the latest estimate of each channel's noise-free value (channel units): the filter's
+        for the channels used at that sample; for the others (hidden, lost, gated) the filter's ``s`` calibrated as
+        ``sqrt((min(k, 1) s)^2 + model_error_std_^2)``, ``k`` = :attr:`interval_scale_` (see
+        :mod:`estimators.intervals`).
     interval_scale_ : ndarray (n_channels,)
-        Calibration factor on the standard deviation of each channel when it is not used, learned by :meth:`fit`
-        (ones with ``calibrate=False``), in [0.3, 3]. Read by :meth:`reset`.
+        Calibration factor on the standard deviation of each channel when it alone is not used, learned by
+        :meth:`fit` (ones with ``calibrate=False``), in [0.3, 3]. Read by :meth:`reset`.
+    model_error_std_ : ndarray (n_channels,)
+        Standard deviation of the error the model does not know about, per channel (channel units):
+        ``sqrt(max(k^2 - 1, 0))`` times ``calibration_["loo_std"]``.
     calibration_ : dict
         How the calibration was made: ``held_out`` (True if on training samples the likelihood did not use, False
-        if on all of them), ``n_samples`` (samples per channel compared; 0 if none) and ``raw_scale`` (the factors
-        before they are kept in [0.3, 3]; ones where none could be made).
+        if on all of them), ``n_samples`` (samples per channel compared; 0 if none), ``raw_scale`` (the factors
+        before they are kept in [0.3, 3]; ones where none could be made) and ``loo_std`` (the leave-one-out
+        filter's steady-state standard deviation of each channel, channel units; zeros without calibration).
 
     Notes
     -----
@@ -217,11 +224,13 @@ class KoopmanKalmanSensor:
     The reported standard deviation is that of the noise-free channel ``C a`` (for the 95 % interval of the truth,
     not of a noisy measurement). It carries the model's uncertainty as identified from the training data; errors
     of the operator itself (nonlinearity, operating conditions outside the training set) are only represented as
-    far as they showed in the one-step residuals. For the channels not used at a sample it is multiplied by
-    :attr:`interval_scale_`, learned leave-one-channel-out and applied to whatever set of channels is lost; the
-    channels used keep the filter's standard deviation (for a channel lost for a single sample the factor is that
-    of a lasting loss, which is the weak point with rapidly changing masks: with 40 % of the samples lost at
-    random, the lost samples of the gauge-8 moment are covered 88 % of the time, the others 92-97 %).
+    far as they showed in the one-step residuals. For the channels not used at a sample it is calibrated with
+    :attr:`interval_scale_`, learned leave-one-channel-out and applied to whatever set of channels is lost (a
+    factor below 1 scales the filter's standard deviation, one above 1 adds an unmodelled error of fixed variance,
+    :attr:`model_error_std_`; see :mod:`estimators.intervals`); the channels used keep the filter's standard
+    deviation (for a channel lost for a single sample the factor is that of a lasting loss, which is the weak
+    point with rapidly changing masks: with 40 % of the samples lost at random, the lost samples of the gauge-8
+    moment are covered 88 % of the time, the others 92-97 %).
 
     Examples
     --------
@@ -422,7 +431,7 @@ class KoopmanKalmanSensor:
         self._P0 = P0
         self._cache: OrderedDict[bytes, dict | None] = OrderedDict()
         self.interval_scale_ = np.ones(p)
-        self.calibration_ = {"held_out": False, "n_samples": 0, "raw_scale": np.ones(p)}
+        self.calibration_ = {"held_out": False, "n_samples": 0, "raw_scale": np.ones(p), "loo_std": np.zeros(p)}
         if self.calibrate:
             self._calibrate(pieces, em_used, int(self.max_fit_samples))
         self.reset()
@@ -490,6 +499,8 @@ class KoopmanKalmanSensor:
                                              _CALIB_MAX_FACTOR * max_samples)
         n_eval = sum(b - a for a, b in spans)
         raw = np.ones(p)
+        loo_var = np.array([float(out[i] @ f["Pf"] @ out[i]) if f is not None else 0.0
+                            for i, f in enumerate(filters[1:])])
         if n_eval >= _CALIB_MIN_SAMPLES:
             diffs: list[list[np.ndarray]] = [[] for _ in range(p)]
             ref = filters[0]
@@ -515,7 +526,13 @@ class KoopmanKalmanSensor:
                 if math.isfinite(c) and c > 0:
                     raw[i] = c / math.sqrt(var_model)
         self.interval_scale_ = np.clip(raw, *_CALIB_BOUNDS)
-        self.calibration_ = {"held_out": held_out, "n_samples": n_eval, "raw_scale": raw}
+        self.calibration_ = {"held_out": held_out, "n_samples": n_eval, "raw_scale": raw,
+                             "loo_std": np.sqrt(np.maximum(loo_var, 0.0)) * self.scale_}
+
+    @property
+    def model_error_std_(self) -> np.ndarray:
+        """Standard deviation of the unmodelled error of each channel (channel units), from the calibration."""
+        return model_error_std(self.interval_scale_, self.calibration_["loo_std"])
 
     def _model_mats(self, phi: float, q_n: np.ndarray, rho: np.ndarray):
         """(F, Q, H, R) of the augmented model [a; n] in z-scored units."""
@@ -551,8 +568,9 @@ class KoopmanKalmanSensor:
         scale = np.asarray(self.interval_scale_, dtype=float)
         if scale.shape != (self.n_channels_,) or not np.all((scale > 0) & np.isfinite(scale)):
             raise ValueError(f"interval_scale_ must hold {self.n_channels_} positive finite factors, got {scale!r}")
-        self._unused_scale = scale.copy()
-        self.std_ = self._std_of(self._P) * self._unused_scale
+        self._k = scale.copy()
+        self._err_std = model_error_std(scale, self.calibration_["loo_std"])
+        self.std_ = unmeasured_std(self._std_of(self._P), self._k, self._err_std)
 
     def _std_of(self, P: np.ndarray) -> np.ndarray:
         r = self.rank_
@@ -707,11 +725,11 @@ class KoopmanKalmanSensor:
         if used_key is None:
             self.n_blind_ += 1
         est = self.mean_ + self.scale_ * (self._C @ x[:r])
-        # calibrated: channels not used at this sample (hidden, lost, gated) get their interval scale
-        mult = self._unused_scale.copy()
+        # calibrated: channels not used at this sample (hidden, lost, gated); the used keep the filter's
+        std = unmeasured_std(post_std, self._k, self._err_std)
         if used_idx is not None:
-            mult[used_idx] = 1.0
-        post_std = post_std * mult
+            std[used_idx] = post_std[used_idx]
+        post_std = std
         self.std_ = post_std
         # predict to the next sample (F is block diagonal: Koopman operator, AR(1) noise)
         x_next = np.empty_like(x)

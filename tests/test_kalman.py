@@ -136,8 +136,17 @@ def test_calibration_widens_the_intervals_of_unmeasured_channels_only(oscillator
     est_c, std_c = calibrated.reconstruct(y_test[:600], mask, return_std=True)
     est_p, std_p = plain.reconstruct(y_test[:600], mask, return_std=True)
     np.testing.assert_array_equal(est_c, est_p)  # the estimates are the same filter's
-    expected = np.where(mask, 1.0, calibrated.interval_scale_)  # measured channels keep the filter's std
-    np.testing.assert_allclose(std_c, std_p * expected, rtol=1e-12)
+    # measured channels keep the filter's std; unmeasured ones add the calibrated unmodelled-error variance
+    me = calibrated.model_error_std_
+    expected = np.where(mask, std_p, np.sqrt(std_p**2 + me**2))
+    np.testing.assert_allclose(std_c, expected, rtol=1e-12)
+    # at the calibration's own pattern (x2 alone lost, steady state) that is the factor times the filter's std,
+    # and the filter's std is the leave-one-out one the calibration used
+    np.testing.assert_allclose(std_p[250, 1], calibrated.calibration_["loo_std"][1], rtol=1e-6)
+    np.testing.assert_allclose(std_c[250, 1], calibrated.interval_scale_[1] * std_p[250, 1], rtol=1e-6)
+    # with a2 lost as well the filter's std grows, the unmodelled part does not: less than proportional widening
+    assert std_p[550, 1] > std_p[250, 1] * 1.001
+    assert std_c[550, 1] / std_p[550, 1] < std_c[250, 1] / std_p[250, 1]
 
 
 def test_calibration_restores_coverage_with_coloured_sensor_noise(oscillator):
@@ -151,8 +160,7 @@ def test_calibration_restores_coverage_with_coloured_sensor_noise(oscillator):
     y_test = y_test + coloured_noise(y_test.shape[0], 12, col, tau=2.0)
     calibrated = KalmanSensor(sys, dt=DT).fit(y_train)
     plain = copy.deepcopy(calibrated)
-    plain.interval_scale_ = np.ones(4)
-    plain._std_scale = plain.scale_.copy()
+    plain.interval_scale_ = np.ones(4)  # read at reset(): the filter's own standard deviations
     for hidden in (0, 1, 3):
         mask = np.ones(4, dtype=bool)
         mask[hidden] = False
@@ -512,10 +520,11 @@ def paper_sensor_default_noise():
 @pytest.mark.parametrize("name", [
     "B",
     pytest.param("A", marks=pytest.mark.xfail(strict=True, reason=(
-        "TwHt3MLyt (channel 11) covers 0.81: its calibration factor comes out 1.18 where about 1.5-1.75 is "
+        "TwHt3MLyt (channel 11) covers 0.79: its calibration factor comes out 1.18 where about 1.5-1.75 is "
         "needed, because the realised variance of its slow sensor noise over the held-out training data is 6 % "
         "below the fitted noise variance, which the calibration subtracts and which is 13 times the filter's "
-        "error variance for that channel (see KalmanSensor._calibrate); the other seven channels cover 0.95-0.98"))),
+        "error variance for that channel (see KalmanSensor._calibrate); TwHt6MLyt covers 0.905, the other six "
+        "channels 0.95-0.97, all hidden samples together 0.93 (test_pooled_coverage_...)"))),
 ])
 def test_intervals_are_calibrated_on_surrogate_data_with_default_noise(paper_sensor_default_noise, name):
     """The surrogate's default sensor noise (white plus a slow AR(1) part on every tower channel): train on the
@@ -527,3 +536,16 @@ def test_intervals_are_calibrated_on_surrogate_data_with_default_noise(paper_sen
     print(f"\nscenario {name}, default sensor noise: R2 {np.round(r2_h, 5)}, 95% coverage {np.round(cover_h, 3)}")
     assert np.median(r2_h) >= 0.999 and r2_h.min() >= 0.995
     assert np.all((cover_h >= 0.90) & (cover_h <= 0.98))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["A", "B"])
+def test_pooled_coverage_on_surrogate_data_with_default_noise(paper_sensor_default_noise, name):
+    """The issue's criterion: the 95 % intervals cover the truth 90-98 % of the time on held-out data, over every
+    hidden sample of the scenario (each channel is hidden throughout, so the pooled coverage is the channels'
+    mean). Per channel see the test above."""
+    surrogates, model, sensor = paper_sensor_default_noise
+    _, _, cover_h = scenario_scores(surrogates, model, sensor, name, duration=300.0)
+    print(f"\nscenario {name}, default sensor noise: pooled 95% coverage {np.mean(cover_h):.3f}")
+    assert 0.90 <= np.mean(cover_h) <= 0.98
+    assert np.all((cover_h >= 0.75) & (cover_h <= 0.995))  # no channel far off either way

@@ -165,8 +165,8 @@ def test_filter_recursion_matches_a_textbook_kalman_filter(oscillator):
     assert ungated._steady is not None  # the long fixed stretch ran on the cached steady-state gain
     ref_est, ref_std = textbook_filter(ungated, Y, masks)
     np.testing.assert_allclose(est, ref_est, rtol=0, atol=1e-7 * sensor.scale_.max())
-    # the calibration scales the standard deviation of the channels not used at a sample, and nothing else
-    np.testing.assert_allclose(std, ref_std * np.where(masks, 1.0, ungated.interval_scale_), rtol=1e-6)
+    # the calibration changes the standard deviation of the channels not used at a sample, and nothing else
+    np.testing.assert_allclose(std, calibrated_std(ungated, ref_std, masks), rtol=1e-6)
     assert ungated.n_blind_ == int((~masks.any(axis=1)).sum()) >= 10
     uncalibrated = copy.deepcopy(ungated)
     uncalibrated.interval_scale_ = np.ones(4)  # read at reset()
@@ -210,6 +210,14 @@ def test_causal_estimates_do_not_see_the_future(oscillator):
     assert not np.allclose(est_b[k + 1 :], est_a[k + 1 :])
 
 
+def calibrated_std(sensor: KoopmanKalmanSensor, own: np.ndarray, used: np.ndarray) -> np.ndarray:
+    """The documented rule: a channel not used gets ``sqrt((min(k, 1) s)^2 + (k^2 - 1)_+ s_L^2)`` from the filter's
+    ``s``, its factor ``k`` and its leave-one-out std ``s_L``; a used channel keeps ``s``."""
+    k, s_loo = sensor.interval_scale_, sensor.calibration_["loo_std"]
+    unused = np.sqrt((np.minimum(k, 1.0) * own) ** 2 + np.maximum(k**2 - 1.0, 0.0) * s_loo**2)
+    return np.where(used, own, unused)
+
+
 def test_calibration_leaves_the_estimates_alone(oscillator):
     """calibrate=False: the filter's own standard deviations; estimates, and the std of used channels, identical."""
     y_train, y_test, _, _ = oscillator
@@ -226,7 +234,7 @@ def test_calibration_leaves_the_estimates_alone(oscillator):
     est_c, std_c = calibrated.reconstruct(y_test[:1500], mask, return_std=True)
     est_p, std_p = plain.reconstruct(y_test[:1500], mask, return_std=True)
     np.testing.assert_array_equal(est_c, est_p)
-    np.testing.assert_allclose(std_c, std_p * np.where(mask, 1.0, calibrated.interval_scale_), rtol=1e-12)
+    np.testing.assert_allclose(std_c, calibrated_std(calibrated, std_p, mask), rtol=1e-12)
     with pytest.raises(ValueError, match="interval_scale_"):
         bad = copy.deepcopy(calibrated)
         bad.interval_scale_ = np.array([1.0, 0.0, 1.0, 1.0])
@@ -447,17 +455,18 @@ def test_paper_scenarios_on_surrogate_data(paper_scenarios):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["A", "B", "C"])
 def test_intervals_of_the_paper_scenarios_are_calibrated(paper_scenarios, name):
-    """The 95 % intervals of the hidden channels cover the truth 90-99 % of the time (uncalibrated: A 0.913-0.999,
-    B 0.904-0.997, C 0.904-0.999).
+    """The issue's criterion: over every hidden sample of the scenario the 95 % intervals cover the truth 90-98 % of
+    the time (each channel is hidden throughout, so that is the channels' mean; here A 0.960, B 0.958, C 0.963).
 
-    The issue asks for 90-98 %. On this machine B meets it (0.943-0.980) and every channel of A and C covers at
-    least 0.944, but three are conservative by up to 0.009: TwHt8MLyt in A 0.989 (its leave-one-out factor is
-    0.86 where scenario A needs about 0.65: with seven other channels lost its error hardly grows while the
-    filter's standard deviation grows 12 %), TwHt1ALxt 0.982 and TwHt9MLyt 0.981 in C (channel 17's factor comes
-    out 1.01 where the truth gives 0.89; see KoopmanKalmanSensor._calibrate). The bound asserted is 0.99 so that
-    a last-digit change of BLAS does not flip B's 0.9798 (the numbers are printed by the fixture)."""
+    Per channel 0.939-0.989 (uncalibrated: A 0.906-0.999, B 0.898-0.997, C 0.899-0.999). Above 0.98 are TwHt8MLyt
+    in A (0.989: its leave-one-out factor is 0.86 where scenario A needs about 0.65; with seven other channels
+    lost its error hardly grows while the filter's standard deviation grows 12 %), TwHt1ALxt and TwHt9MLyt in C
+    (0.982, 0.981: channel 17's factor comes out 1.01 where the truth gives 0.89; see
+    KoopmanKalmanSensor._calibrate). The per-channel bound asserted is 0.99 so that a last-digit change of BLAS
+    does not flip them (the numbers are printed by the fixture)."""
     _, results = paper_scenarios
     cover_h = results[name][2]
+    assert 0.90 <= np.mean(cover_h) <= 0.98, np.round(cover_h, 4)
     assert np.all((cover_h >= 0.90) & (cover_h <= 0.99)), np.round(cover_h, 4)
 
 
