@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["unmeasured_std", "model_error_std"]
+__all__ = ["unmeasured_std", "model_error_std", "calibration_terms"]
 
 
 def model_error_std(interval_scale: np.ndarray, loo_std: np.ndarray) -> np.ndarray:
@@ -62,3 +62,30 @@ def unmeasured_std(filter_std: np.ndarray, interval_scale: np.ndarray, error_std
     """
     shrunk = np.minimum(interval_scale, 1.0) * filter_std
     return np.sqrt(shrunk * shrunk + error_std * error_std)
+
+
+def calibration_terms(interval_scale: object, loo_std: np.ndarray, n_channels: int) -> tuple[np.ndarray, np.ndarray]:
+    """Checked factors and their :func:`model_error_std`, as a sensor's ``reset()`` reads them.
+
+    Parameters
+    ----------
+    interval_scale : array_like (n_channels,)
+        The sensor's ``interval_scale_`` (-).
+    loo_std : ndarray (n_channels,)
+        Its ``calibration_["loo_std"]`` (channel units).
+    n_channels : int
+        Number of channels.
+
+    Returns
+    -------
+    k, error_std : ndarray (n_channels,)
+
+    Raises
+    ------
+    ValueError
+        If the factors are not ``n_channels`` positive finite numbers.
+    """
+    k = np.array(interval_scale, dtype=float)
+    if k.shape != (n_channels,) or not np.all((k > 0) & np.isfinite(k)):
+        raise ValueError(f"interval_scale_ must hold {n_channels} positive finite factors, got {interval_scale!r}")
+    return k, model_error_std(k, loo_std)

@@ -52,7 +52,7 @@ from scipy.linalg.lapack import dpotrf as _dpotrf
 from scipy.linalg.lapack import dtrtri as _dtrtri
 from scipy.signal import lfilter
 
-from .intervals import model_error_std, unmeasured_std
+from .intervals import calibration_terms, model_error_std, unmeasured_std
 
 __all__ = ["KalmanSensor"]
 
@@ -707,11 +707,8 @@ class KalmanSensor:
         self.n_gated_ = 0
         self.gated_counts_ = np.zeros(self.n_channels_, dtype=int)
         self.n_blind_ = 0
-        scale = np.asarray(self.interval_scale_, dtype=float)
-        if scale.shape != (self.n_channels_,) or not np.all((scale > 0) & np.isfinite(scale)):
-            raise ValueError(f"interval_scale_ must hold {self.n_channels_} positive finite factors, got {scale!r}")
-        self._k = scale.copy()
-        self._err_std = model_error_std(scale, self.calibration_["loo_std"])
+        self._k, self._err_std = calibration_terms(self.interval_scale_, self.calibration_["loo_std"],
+                                                   self.n_channels_)
         self.std_ = unmeasured_std(
             np.sqrt(np.einsum("ij,jk,ik->i", self._H, self._P, self._H)) * self.scale_, self._k, self._err_std)
         self.input_estimate_ = np.zeros(len(self._iu))

@@ -89,7 +89,7 @@ from scipy.linalg.lapack import dtrtri as _dtrtri
 from scipy.signal import lfilter
 
 from .hankel_dmd import HankelDMD
-from .intervals import model_error_std, unmeasured_std
+from .intervals import calibration_terms, model_error_std, unmeasured_std
 from .validation import NotFittedError, apply_masks, as_records, check_int, check_number, split_at_nonfinite
 
 __all__ = ["KoopmanKalmanSensor"]
@@ -565,11 +565,8 @@ class KoopmanKalmanSensor:
         self.n_gated_ = 0
         self.gated_counts_ = np.zeros(self.n_channels_, dtype=int)
         self.n_blind_ = 0
-        scale = np.asarray(self.interval_scale_, dtype=float)
-        if scale.shape != (self.n_channels_,) or not np.all((scale > 0) & np.isfinite(scale)):
-            raise ValueError(f"interval_scale_ must hold {self.n_channels_} positive finite factors, got {scale!r}")
-        self._k = scale.copy()
-        self._err_std = model_error_std(scale, self.calibration_["loo_std"])
+        self._k, self._err_std = calibration_terms(self.interval_scale_, self.calibration_["loo_std"],
+                                                   self.n_channels_)
         self.std_ = unmeasured_std(self._std_of(self._P), self._k, self._err_std)
 
     def _std_of(self, P: np.ndarray) -> np.ndarray:
