@@ -5,6 +5,8 @@ Never imports :mod:`surrogates` or Gymnasium: the same code runs on surrogate, O
 * preprocessing -- :func:`preprocess`, :class:`Preprocessor` (band-pass + z-score, zero-phase or causal streaming);
 * identification -- :class:`HankelDMD`, :class:`SSICov`, :func:`mac`, :func:`pair_modes`,
   :func:`probabilistic_mode_shapes`, :func:`harmonic_candidates`, :func:`lyapunov_exponent` (Rosenstein);
+* order tracking -- :func:`rotor_harmonics` (rotor-locked lines by Hankel-DMD at equal azimuth steps, whatever
+  the rotor speed does), :func:`resample_to_azimuth`, :func:`rotor_azimuth`;
 * virtual sensors -- :class:`HankelDMDSensor` (causal rolling-horizon Hankel-DMD), :class:`KalmanSensor`
   (augmented Kalman filter on a linear model), :class:`KoopmanKalmanSensor` (Kalman filter on the identified
   Hankel-DMD operator), :class:`HoldLastValue` (floor baseline);
@@ -27,11 +29,13 @@ from .lyapunov import (
 )
 from .metrics import nrmse, r2_score, reconstruction_scores
 from .modal import ModeShapeDistribution, mac, pair_modes, probabilistic_mode_shapes, real_mode_shape
+from .order_tracking import AngleDomainData, resample_to_azimuth, rotor_azimuth, rotor_harmonics
 from .preprocess import Preprocessor, band_sos, preprocess
 from .ssi_cov import SSICov, correlation_sums
 from .validation import NotFittedError
 
 __all__ = [
+    "AngleDomainData",
     "HankelDMD",
     "HankelDMDSensor",
     "HoldLastValue",
@@ -58,6 +62,9 @@ __all__ = [
     "r2_score",
     "real_mode_shape",
     "reconstruction_scores",
+    "resample_to_azimuth",
+    "rotor_azimuth",
+    "rotor_harmonics",
     "svht_omega",
     "svht_rank",
 ]

@@ -809,7 +809,7 @@ def harmonic_candidates(
     -------
     list of dict
         ``frequency_hz`` (mean over delays), ``frequency_spread_hz`` (max - min), ``damping_ratios`` (one per
-        delay), ``energy`` (mean share), sorted by frequency.
+        delay), ``energy`` (mean share), ``phase_locking`` (smallest over delays), sorted by frequency.
     """
     if not delays:
         raise ValueError("delays must list at least one delay depth")
@@ -836,6 +836,7 @@ def harmonic_candidates(
                     "frequency_spread_hz": float(np.ptp(f)),
                     "damping_ratios": [m["damping_ratio"] for m in matches],
                     "energy": float(np.mean([m["energy"] for m in matches])),
+                    "phase_locking": float(min(m["phase_locking"] for m in matches)),
                 }
             )
     return sorted(out, key=lambda r: r["frequency_hz"])

@@ -217,8 +217,9 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                                                                          else int(args.rank))
     delays: int | float = float(args.delays) if "." in args.delays else int(args.delays)
     t0 = time.perf_counter()
+    rotor_speed = None if args.rotor_speed.lower() == "none" else args.rotor_speed
     res = identify(rec, channels=channels, plane=args.plane, delays=delays, rank=rank, ssi=not args.no_ssi,
-                   reference=ref)
+                   reference=ref, rotor_speed=rotor_speed)
     print(res.summary())
     print(f"({time.perf_counter() - t0:.1f} s)")
     if args.json:
@@ -529,6 +530,9 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("--effects", default="all", help="effects of the reference model")
     i.add_argument("--no-reference", action="store_true", help="do not compare with the linearised model")
     i.add_argument("--no-ssi", action="store_true", help="skip SSI-COV")
+    i.add_argument("--rotor-speed", default="auto", metavar="CHANNEL",
+                   help="rotor-speed channel (rpm or rad/s) for the order-tracked rotor harmonics; 'auto' "
+                        "(default): RotSpeed if the record has it and the rotor turns; 'none': skip")
     i.add_argument("--json", default=None, help="write modes and pairing as JSON")
     i.add_argument("--plot", default=None, help="folder for the figures")
     i.set_defaults(func=_cmd_identify)

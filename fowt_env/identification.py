@@ -6,13 +6,17 @@ the chosen channels as the seed paper does (4th-order Butterworth 0.25-5 Hz, zer
 * :class:`estimators.HankelDMD` (mode table with structural / harmonic / noise labels), and
 * :class:`estimators.SSICov` (stabilisation diagram, stable poles),
 
-both on the same data. Mode shapes are returned in the record's physical units (the z-scoring is undone), so
-they compare directly with the output shapes ``C v`` of a linear model: :func:`linear_reference` gives those
-for a ``control.StateSpace`` (e.g. ``FOWTModel.linearize(case, plane="FA")``) and :func:`identify` pairs every
-method's modes with them (frequency and MAC) when a reference is given -- the seed paper's Table 3.
+both on the same data, and, when the record carries the rotor speed (``RotSpeed``), finds the rotor harmonics
+(1P, 3P, 6P) by Hankel-DMD in the order domain (:func:`estimators.rotor_harmonics`): a 3P load on a rotor whose
+speed follows the turbulence is a band in time but a line at order 3 in azimuth. Mode shapes are returned in
+the record's physical units (the z-scoring is undone), so they compare directly with the output shapes ``C v``
+of a linear model: :func:`linear_reference` gives those for a ``control.StateSpace`` (e.g.
+``FOWTModel.linearize(case, plane="FA")``) and :func:`identify` pairs every method's modes with them
+(frequency and MAC) when a reference is given -- the seed paper's Table 3.
 
 :meth:`IdentificationResult.plot` draws the figures people look at: the stabilisation diagram over the PSD,
-the DMD eigenvalues on the unit circle, the singular-value spectrum with the chosen rank, and a spectrogram.
+the DMD eigenvalues on the unit circle, the singular-value spectrum with the chosen rank, and a spectrogram
+with the rotor harmonics' tracks over it.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ from scipy import signal
 
 from estimators.hankel_dmd import HankelDMD
 from estimators.modal import mac, pair_modes
+from estimators.order_tracking import rotor_azimuth, rotor_harmonics
 from estimators.preprocess import Preprocessor
 from estimators.ssi_cov import SSICov
 
@@ -155,6 +160,12 @@ class IdentificationResult:
     pairs : dict of str to list of dict
         For each method (``"dmd"``, ``"ssi"``), the reference modes paired with its modes: ``label``,
         ``f_ref``, ``zeta_ref``, ``f``, ``zeta``, ``freq_rel_error``, ``mac``.
+    harmonics : list of dict or None
+        Rotor harmonics found by Hankel-DMD in the order domain (:func:`estimators.rotor_harmonics` rows:
+        ``order``, ``frequency_hz`` at the mean rotor speed, ``frequency_range_hz`` swept in time,
+        ``damping_ratio``, ``phase_locking``, ``energy``, ``kind``); None when no order tracking was done.
+    rotor_speed_source : str
+        Where the rotor speed came from (a channel name, ``"array"``), or why there are no harmonics.
     """
 
     channels: list[str]
@@ -168,8 +179,11 @@ class IdentificationResult:
     ssi_modes: list[dict]
     reference: LinearReference | None = None
     pairs: dict[str, list[dict]] = field(default_factory=dict)
+    harmonics: list[dict] | None = None
+    rotor_speed_source: str = "not requested"
     _spectrogram_channel: str | None = None
     _y: np.ndarray | None = None
+    _rotor_hz: np.ndarray | None = None
 
     # ------------------------------------------------------------------------------------------ shapes
     def dmd_shape(self, index: int) -> np.ndarray:
@@ -194,6 +208,7 @@ class IdentificationResult:
         }
         if self.ssi is not None:
             out["ssi"] = {"modes": self.ssi_modes}
+        out["rotor_harmonics"] = {"rotor_speed": self.rotor_speed_source, "lines": self.harmonics}
         if self.reference is not None:
             out["reference"] = [
                 {"label": lab, "frequency_hz": float(f), "damping_ratio": float(z)}
@@ -213,6 +228,16 @@ class IdentificationResult:
             if row["kind"] in kinds:
                 lines.append(f"  {row['frequency_hz']:8.4f} {100 * row['damping_ratio']:9.2f} {row['energy']:7.3f} "
                              f"{row['phase_locking']:8.2f}  {row['kind']}")
+        if self.harmonics is None:
+            lines.append(f"Rotor harmonics: not tracked ({self.rotor_speed_source})")
+        else:
+            lines.append(f"Rotor harmonics (Hankel-DMD at equal azimuth steps, speed from {self.rotor_speed_source}):"
+                         f" {len(self.harmonics)}")
+            lines.append(f"  {'order':>6} {'f (Hz)':>8} {'sweeps (Hz)':>13} {'locking':>8}")
+            for row in self.harmonics:
+                lo, hi = row["frequency_range_hz"]
+                lines.append(f"  {row['order']:6.2f} {row['frequency_hz']:8.4f} {lo:6.3f}-{hi:<6.3f} "
+                             f"{row['phase_locking']:8.2f}")
         if self.ssi is not None:
             lines.append(f"SSI-COV: {len(self.ssi_modes)} stable modes")
             lines.append(f"  {'f (Hz)':>8} {'zeta (%)':>9}")
@@ -253,8 +278,11 @@ class IdentificationResult:
                                               reference=self.reference))
         if self._y is not None and self._spectrogram_channel is not None:
             j = self.channels.index(self._spectrogram_channel)
+            tracks = None
+            if self.harmonics and self._rotor_hz is not None:
+                tracks = {f"{row['order']:.0f}P": row["order"] * self._rotor_hz for row in self.harmonics}
             paths.append(spectrogram_figure(self._y[:, j], self.dt, self._spectrogram_channel, self.units[j],
-                                            folder / "spectrogram.png"))
+                                            folder / "spectrogram.png", tracks=tracks))
         return paths
 
 
@@ -280,6 +308,37 @@ def _pair(reference: LinearReference, freqs: np.ndarray, zetas: np.ndarray, shap
     return sorted(out, key=lambda p: p["f_ref"])
 
 
+_SPEED_UNITS = {"rpm": np.pi / 30.0, "rad/s": 1.0}
+
+
+def _rotor_speed(record: Any, rotor_speed: Any) -> tuple[np.ndarray | None, str]:
+    """Rotor speed (rad/s) for order tracking and where it came from (or why there is none)."""
+    if rotor_speed is None:
+        return None, "not requested"
+    auto = isinstance(rotor_speed, str) and rotor_speed == "auto"
+    if isinstance(rotor_speed, str):
+        name = "RotSpeed" if auto else rotor_speed
+        if name not in record.channels:
+            if auto:
+                return None, "the record has no RotSpeed channel"
+            raise ValueError(f"rotor_speed: no channel {name!r} in the record; it has {record.channels}")
+        unit = record.units[record.channels.index(name)]
+        if unit not in _SPEED_UNITS:
+            raise ValueError(f"rotor_speed: channel {name!r} is in {unit!r}; expected one of {list(_SPEED_UNITS)}")
+        w = np.asarray(record.select([name]).y[:, 0], dtype=float) * _SPEED_UNITS[unit]
+        source = name
+    else:
+        w = np.asarray(rotor_speed, dtype=float)
+        if w.shape != (record.n_samples,):
+            raise ValueError(f"rotor_speed must be a channel name or an array of shape ({record.n_samples},) in "
+                             f"rad/s, got shape {w.shape}")
+        source = "array"
+    if auto and not (np.isfinite(w).all() and (w > 0).all()):
+        return None, f"{source} is not finite and > 0 throughout (rotor parked, idling or stopping)"
+    rotor_azimuth(w, float(record.dt))  # explicit speeds: a clear error if not finite or not turning
+    return w, source
+
+
 def identify(
     record: Any,
     *,
@@ -294,6 +353,7 @@ def identify(
     ssi_orders: Any = None,
     reference: LinearReference | None = None,
     max_freq_rel: float = 0.1,
+    rotor_speed: str | np.ndarray | None = "auto",
 ) -> IdentificationResult:
     """Identify modes of a record with Hankel-DMD and SSI-COV, optionally paired with a linear reference.
 
@@ -330,6 +390,11 @@ def identify(
         Linear modes to pair with (:func:`linear_reference`); its output names must cover ``channels``.
     max_freq_rel : float
         Largest relative frequency difference accepted when pairing with the reference.
+    rotor_speed : "auto", str, ndarray or None
+        Rotor speed for the order-tracked harmonics: a channel name (units rpm or rad/s), an array
+        ``(n_samples,)`` in rad/s, ``None`` (skip), or ``"auto"`` (default): the ``RotSpeed`` channel if the
+        record has one and the rotor turns throughout (a parked or idling record is skipped, with the reason
+        in :attr:`IdentificationResult.rotor_speed_source`).
 
     Returns
     -------
@@ -338,8 +403,8 @@ def identify(
     Raises
     ------
     ValueError
-        Unknown channels, a band above Nyquist, NaN in the data, too short a record, or a reference without
-        the channels.
+        Unknown channels, a band above Nyquist, NaN in the data, too short a record, a reference without
+        the channels, or an explicit rotor speed that is unknown, of the wrong length or unit, or not turning.
     """
     names = list(channels) if channels is not None else _default_channels(record, plane)
     missing = [c for c in names if c not in record.channels]
@@ -351,6 +416,7 @@ def identify(
             raise ValueError(f"reference: the linear model has no outputs {absent}")
     sub = record.select(names)
     dt = float(record.dt)
+    speed, speed_source = _rotor_speed(record, rotor_speed)
     nyq = 0.5 / dt
     lo, hi = (float(b) for b in band)
     if not 0 < lo < nyq:
@@ -378,9 +444,15 @@ def identify(
                             else ssi_orders)
         ssi_est = SSICov(dt_d, **kwargs).fit(Zd)
         ssi_modes = ssi_est.mode_table()
+    harmonics = None
+    if speed is not None:
+        psi = rotor_azimuth(speed, dt)[::q]
+        depths = tuple(sorted({max(2, int(round(f * delays))) for f in (0.8, 1.0, 1.2)}))
+        harmonics = rotor_harmonics(Zd, dt_d, azimuth=psi, delays=depths, rank=rank)
     res = IdentificationResult(names, [sub.units[i] for i in range(len(names))], dt, (lo, hi), filtered_std, dmd,
-                               ssi_est, dmd_modes, ssi_modes, _y=Y,
-                               _spectrogram_channel=next((c for c in names if c.endswith("ALxt") or
+                               ssi_est, dmd_modes, ssi_modes, harmonics=harmonics, rotor_speed_source=speed_source,
+                               _rotor_hz=None if speed is None else speed / (2.0 * np.pi), _y=Y,
+                               _spectrogram_channel=next((c for c in reversed(names) if c.endswith("ALxt") or
                                                           c.endswith("ALyt")), names[0]))
     if reference is not None:
         rows = [reference.channels.index(c) for c in names]

@@ -187,7 +187,7 @@ def singular_value_figure(dmd, path: str | Path) -> Path:
 
 
 def spectrogram_figure(x: np.ndarray, dt: float, name: str, unit: str, path: str | Path,
-                       f_max: float = 3.0) -> Path:
+                       f_max: float = 3.0, tracks: dict[str, np.ndarray] | None = None) -> Path:
     """Spectrogram (dB) of one channel: how the spectrum moves with time (rotor speed, sea state).
 
     Parameters
@@ -202,6 +202,9 @@ def spectrogram_figure(x: np.ndarray, dt: float, name: str, unit: str, path: str
         Output PNG file.
     f_max : float
         Upper frequency (Hz).
+    tracks : dict of str to ndarray (n_samples,), optional
+        Frequencies (Hz) to draw over the spectrogram, one per sample of ``x`` (e.g. ``{"3P": 3 * rotor
+        frequency}``), averaged over each spectrogram window.
 
     Returns
     -------
@@ -218,6 +221,16 @@ def spectrogram_figure(x: np.ndarray, dt: float, name: str, unit: str, path: str
     fig, ax = plt.subplots(figsize=(9, 4.5))
     im = ax.pcolormesh(t, f[sel], 10 * np.log10(S[sel] + 1e-300), shading="auto", cmap="viridis")
     fig.colorbar(im, ax=ax, label=f"PSD (dB re 1 ({unit})²/Hz)")
+    for k, (label, track) in enumerate((tracks or {}).items()):
+        track = np.asarray(track, dtype=float)
+        if track.shape != (len(x),):
+            raise ValueError(f"tracks[{label!r}] must have shape ({len(x)},), got {track.shape}")
+        win = np.ones(nper) / nper
+        smooth = np.convolve(track, win, mode="same")[(t * fs).astype(int).clip(0, len(x) - 1)]
+        ax.plot(t, smooth, ls="--", lw=1.2, color=("w", "orange", "r", "c")[k % 4], label=label)
+    if tracks:
+        ax.legend(loc="upper right", fontsize=8)
+    ax.set_ylim(f[sel][0], f[sel][-1])
     ax.set_xlabel("time (s)")
     ax.set_ylabel("frequency (Hz)")
     ax.set_title(f"Spectrogram of {name}")

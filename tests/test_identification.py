@@ -74,6 +74,56 @@ def test_identify_recovers_a_known_system_and_pairs_it(tmp_path):
     assert all(p.stat().st_size > 10_000 for p in paths)
 
 
+def _with_rotor(rec, rpm: np.ndarray, amplitude: float = 0.3):
+    """The 2-DOF record plus a 3P load response on every channel and a RotSpeed channel (rpm)."""
+    psi = np.concatenate([[0.0], np.cumsum(0.5 * (rpm[1:] + rpm[:-1]) * np.pi / 30 * DT)])
+    y = rec.y + amplitude * rec.y.std(axis=0) * np.cos(3 * psi[:, None] + np.array([0.0, 0.5, 1.0]))
+    return surrogates.Record(rec.t, np.c_[y, rpm], rec.channels + ["RotSpeed"], rec.units + ["rpm"])
+
+
+def test_identify_tracks_the_3p_band_of_a_wandering_rotor(tmp_path):
+    _, rec = _two_dof(duration=600.0)
+    t = rec.t
+    rpm = 12.1 * (1 + 0.08 * np.sin(2 * np.pi * t / 70.0) + 0.05 * np.sin(2 * np.pi * t / 23.0 + 1.0))
+    rec = _with_rotor(rec, rpm)
+    chans = ["acc1", "acc2", "force"]
+    res = identify(rec, channels=chans, band=(0.2, 5.0), ssi=False)
+    assert res.rotor_speed_source == "RotSpeed"
+    f3 = 3 * np.mean(rpm) / 60
+    assert [round(h["order"], 2) for h in res.harmonics] == [3.0]
+    assert res.harmonics[0]["frequency_hz"] == pytest.approx(f3, rel=0.005)
+    assert res.harmonics[0]["phase_locking"] > 0.9
+    # in time the same band (+-13 % speed) is no harmonic line
+    assert not [r for r in res.dmd_modes if r["kind"] == "harmonic" and abs(r["frequency_hz"] - f3) < 0.2 * f3]
+    d = json.loads(json.dumps(res.to_dict()))
+    assert d["rotor_harmonics"]["rotor_speed"] == "RotSpeed" and len(d["rotor_harmonics"]["lines"]) == 1
+    assert "order" in res.summary() and "3.00" in res.summary()
+    assert len(res.plot(tmp_path)) == 3
+    # the same speed given as an array (rad/s), or no order tracking at all
+    same = identify(rec, channels=chans, band=(0.2, 5.0), ssi=False, rotor_speed=rpm * np.pi / 30)
+    assert same.rotor_speed_source == "array"
+    assert [h["frequency_hz"] for h in same.harmonics] == pytest.approx([h["frequency_hz"] for h in res.harmonics])
+    off = identify(rec, channels=chans, band=(0.2, 5.0), ssi=False, rotor_speed=None)
+    assert off.harmonics is None and "not tracked" in off.summary()
+
+
+def test_identify_rotor_speed_errors_and_parked_rotor():
+    _, rec = _two_dof(duration=60.0)
+    parked = _with_rotor(rec, np.zeros(rec.n_samples), amplitude=0.0)
+    res = identify(parked, channels=["acc1", "acc2"], ssi=False)  # auto: a parked rotor is skipped, with why
+    assert res.harmonics is None and "parked" in res.rotor_speed_source
+    with pytest.raises(ValueError, match="turning rotor"):
+        identify(parked, channels=["acc1", "acc2"], ssi=False, rotor_speed="RotSpeed")
+    with pytest.raises(ValueError, match="no channel 'Azimuth'"):
+        identify(parked, channels=["acc1", "acc2"], ssi=False, rotor_speed="Azimuth")
+    with pytest.raises(ValueError, match="expected one of"):
+        identify(parked, channels=["acc1", "acc2"], ssi=False, rotor_speed="acc1")
+    with pytest.raises(ValueError, match="shape"):
+        identify(parked, channels=["acc1", "acc2"], ssi=False, rotor_speed=np.ones(10))
+    res = identify(rec, channels=["acc1", "acc2"], ssi=False)
+    assert res.harmonics is None and "no RotSpeed" in res.rotor_speed_source
+
+
 def test_identify_rejects_bad_channels_and_bands():
     _, rec = _two_dof(duration=60.0)
     with pytest.raises(ValueError, match="not in the record"):
@@ -105,7 +155,11 @@ def test_cli_identify_writes_json_and_figures(tmp_path, capsys):
     assert len(d["channels"]) == 18 and d["dmd"]["rank"] == 24
     assert [r["label"] for r in d["reference"]] == ["tower_fa_1", "tower_fa_2"]  # from the record's own case
     assert len(list((tmp_path / "figs").glob("*.png"))) == 4
+    assert d["rotor_harmonics"]["rotor_speed"] == "RotSpeed"
     assert "tower_fa_1" in capsys.readouterr().out
+    assert main(["identify", str(path), "--plane", "FA", "--no-ssi", "--no-reference", "--rotor-speed", "none",
+                 "--json", str(out)]) == 0
+    assert json.loads(out.read_text())["rotor_harmonics"] == {"rotor_speed": "not requested", "lines": None}
 
 
 def test_cli_identify_bad_path_is_one_line():
@@ -116,7 +170,8 @@ def test_cli_identify_bad_path_is_one_line():
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", [1, 2])
 def test_tower_modes_from_30_minutes_of_olc4(seed):
-    """Issue 5: DMD finds the 1st FA and SS tower modes, SSI-COV the 1st FA mode, within 5 % of the linearization."""
+    """Issue 5: DMD finds the 1st FA and SS tower modes, SSI-COV the 1st FA mode, within 5 % of the linearization,
+    and DMD (in the order domain) labels the 3P line a harmonic."""
     model = surrogates.FOWTModel()
     rec = surrogates.simulate(model, 4, duration=1800.0, seed=seed)
     for plane in ("FA", "SS"):
@@ -127,6 +182,13 @@ def test_tower_modes_from_30_minutes_of_olc4(seed):
         top = max(dmd, key=lambda r: r["energy"])  # the dominant structural mode of the tower in the band
         print(f"\n{plane} seed {seed}: linear {f_lin:.4f} Hz, DMD {top['frequency_hz']:.4f} Hz", end="")
         assert top["frequency_hz"] == pytest.approx(f_lin, rel=0.05)
+        # the 3P line: blade passing of a three-bladed rotor at the record's own mean speed, a harmonic in the
+        # order domain although the rotor speed wanders by several rpm (a band in time)
+        f3 = 3 * rec.select(["RotSpeed"]).y.mean() / 60.0
+        lines = [h for h in res.harmonics if abs(h["order"] - 3.0) < 0.02]
+        print(f", 3P {f3:.4f} Hz: {[round(h['frequency_hz'], 4) for h in lines]}", end="")
+        assert len(lines) == 1 and lines[0]["frequency_hz"] == pytest.approx(f3, rel=0.005)
+        assert all(abs(h["frequency_hz"] - f_lin) > 0.05 * f_lin for h in res.harmonics)  # the tower mode is not one
         if plane == "FA":
             f_ssi = [p["f"] for p in res.pairs["ssi"] if p["label"] == label]
             print(f", SSI {f_ssi}", end="")
