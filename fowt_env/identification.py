@@ -322,7 +322,7 @@ def _rotor_speed(record: Any, rotor_speed: Any) -> tuple[np.ndarray | None, str]
             if auto:
                 return None, "the record has no RotSpeed channel"
             raise ValueError(f"rotor_speed: no channel {name!r} in the record; it has {record.channels}")
-        unit = record.units[record.channels.index(name)]
+        unit = record.units[record.channels.index(name)].strip().lower()
         if unit not in _SPEED_UNITS:
             raise ValueError(f"rotor_speed: channel {name!r} is in {unit!r}; expected one of {list(_SPEED_UNITS)}")
         w = np.asarray(record.select([name]).y[:, 0], dtype=float) * _SPEED_UNITS[unit]
