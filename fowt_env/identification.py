@@ -240,7 +240,10 @@ class IdentificationResult:
                              f"{row['phase_locking']:8.2f}")
         if self.ssi is not None:
             lines.append(f"SSI-COV: {len(self.ssi_modes)} stable modes")
-            lines.append(f"  {'f (Hz)':>8} {'zeta (%)':>9}")
+            if not self.ssi_modes:
+                lines.append("  (no pole stable over the model orders: a longer record usually helps)")
+            else:
+                lines.append(f"  {'f (Hz)':>8} {'zeta (%)':>9}")
             for row in self.ssi_modes:
                 lines.append(f"  {row['frequency_hz']:8.4f} {100 * row['damping_ratio']:9.2f}")
         if self.reference is not None:

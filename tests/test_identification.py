@@ -193,3 +193,11 @@ def test_tower_modes_from_30_minutes_of_olc4(seed):
             f_ssi = [p["f"] for p in res.pairs["ssi"] if p["label"] == label]
             print(f", SSI {f_ssi}", end="")
             assert f_ssi and f_ssi[0] == pytest.approx(f_lin, rel=0.05)
+
+
+def test_summary_says_when_ssi_found_no_stable_pole():
+    rng = np.random.default_rng(0)
+    n = 8000
+    rec = surrogates.Record(np.arange(n) * DT, rng.standard_normal((n, 3)), ["a", "b", "c"], ["m/s^2"] * 3)
+    res = identify(rec, channels=["a", "b", "c"])  # white noise: no mode to stabilise
+    assert res.ssi_modes == [] and "no pole stable" in res.summary()
