@@ -228,7 +228,6 @@ def rotor_harmonics(
     >>> [round(r["order"], 2) for r in rotor_harmonics(Y, dt, rotor_speed=w, rank=4)]
     [3.0]
     """
-    Y = as_2d_float(Y, "Y", min_samples=4)
     ang = resample_to_azimuth(Y, dt, rotor_speed=rotor_speed, azimuth=azimuth)
     f1 = ang.rotor_frequency_hz
     lo, hi = ang.speed_percentiles_hz

@@ -314,16 +314,16 @@ def _pair(reference: LinearReference, freqs: np.ndarray, zetas: np.ndarray, shap
 _SPEED_UNITS = {"rpm": np.pi / 30.0, "rad/s": 1.0}
 
 
-def _rotor_speed(record: Any, rotor_speed: Any) -> tuple[np.ndarray | None, str]:
-    """Rotor speed (rad/s) for order tracking and where it came from (or why there is none)."""
+def _rotor_speed(record: Any, rotor_speed: Any) -> tuple[np.ndarray | None, np.ndarray | None, str]:
+    """Rotor speed (rad/s) and azimuth (rad) for order tracking, and where they came from (or why there are none)."""
     if rotor_speed is None:
-        return None, "not requested"
+        return None, None, "not requested"
     auto = isinstance(rotor_speed, str) and rotor_speed == "auto"
     if isinstance(rotor_speed, str):
         name = "RotSpeed" if auto else rotor_speed
         if name not in record.channels:
             if auto:
-                return None, "the record has no RotSpeed channel"
+                return None, None, "the record has no RotSpeed channel"
             raise ValueError(f"rotor_speed: no channel {name!r} in the record; it has {record.channels}")
         unit = record.units[record.channels.index(name)].strip().lower()
         if unit not in _SPEED_UNITS:
@@ -336,10 +336,13 @@ def _rotor_speed(record: Any, rotor_speed: Any) -> tuple[np.ndarray | None, str]
             raise ValueError(f"rotor_speed must be a channel name or an array of shape ({record.n_samples},) in "
                              f"rad/s, got shape {w.shape}")
         source = "array"
-    if auto and not (np.isfinite(w).all() and (w > 0).all()):
-        return None, f"{source} is not finite and > 0 throughout (rotor parked, idling or stopping)"
-    rotor_azimuth(w, float(record.dt))  # explicit speeds: a clear error if not finite or not turning
-    return w, source
+    try:
+        psi = rotor_azimuth(w, float(record.dt))  # a clear error if not finite or not turning
+    except ValueError:
+        if not auto:
+            raise
+        return None, None, f"{source} is not finite and > 0 throughout (rotor parked, idling or stopping)"
+    return w, psi, source
 
 
 def identify(
@@ -419,7 +422,7 @@ def identify(
             raise ValueError(f"reference: the linear model has no outputs {absent}")
     sub = record.select(names)
     dt = float(record.dt)
-    speed, speed_source = _rotor_speed(record, rotor_speed)
+    speed, azimuth, speed_source = _rotor_speed(record, rotor_speed)
     nyq = 0.5 / dt
     lo, hi = (float(b) for b in band)
     if not 0 < lo < nyq:
@@ -448,10 +451,9 @@ def identify(
         ssi_est = SSICov(dt_d, **kwargs).fit(Zd)
         ssi_modes = ssi_est.mode_table()
     harmonics = None
-    if speed is not None:
-        psi = rotor_azimuth(speed, dt)[::q]
+    if azimuth is not None:
         depths = tuple(sorted({max(2, int(round(f * delays))) for f in (0.8, 1.0, 1.2)}))
-        harmonics = rotor_harmonics(Zd, dt_d, azimuth=psi, delays=depths, rank=rank)
+        harmonics = rotor_harmonics(Zd, dt_d, azimuth=azimuth[::q], delays=depths, rank=rank)
     res = IdentificationResult(names, [sub.units[i] for i in range(len(names))], dt, (lo, hi), filtered_std, dmd,
                                ssi_est, dmd_modes, ssi_modes, harmonics=harmonics, rotor_speed_source=speed_source,
                                _rotor_hz=None if speed is None else speed / (2.0 * np.pi), _y=Y,
