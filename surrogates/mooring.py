@@ -23,13 +23,14 @@ Comparison with OC3 (Jonkman 2010, Table 4-2 region; lines only, moments about S
 ==========  ====================  ==========================
 entry       OC3 published         this solver (zero offset)
 ==========  ====================  ==========================
-K11 = K22   41,180 N/m            41,0xx N/m   (-0.4 %)
-K33         11,940 N/m            11,9xx N/m   (< 1 %)
-K55 = K44   3.11e8 N m/rad        3.08e8 N m/rad (-1 %)
-K15 = -K24  -2.82e6 N             -2.85e6 N    (+1 %)
-K66         1.156e7 N m/rad       1.16e7 N m/rad (< 1 %)
+K11 = K22   41,180 N/m            41,181 N/m
+K33         11,940 N/m            11,941 N/m
+K44 = K55   3.11e8 N m/rad        3.108e8 N m/rad
+K15 = -K24  -2.82e6 N             -2.815e6 N
+K66         1.156e7 N m/rad       1.157e7 N m/rad
 ==========  ====================  ==========================
 
+Pretension (zero offset): Fz = -1.607e6 N (three lines' suspended weight at the fairleads).
 (The exact numbers are printed by ``python -m surrogates.mooring``; ``tests/test_mooring.py`` checks them.)
 The delta-line crow-foot of the real system adds a yaw spring of 9.834e7 N m/rad that three single lines do not
 have; it is *additional* and stays linear in the structural model (``OC3Data.mooring_stiffness``), not here.
