@@ -18,12 +18,20 @@ record goes through :func:`load_record`. Every error they raise is a :class:`Rec
 
 Time axis
 ---------
-Estimators assume uniform sampling, so every reader returns a record on a uniform grid ``t0 + k dt`` (s). A file's
-time stamps must follow such a grid to within its time resolution (the printed digits of a text file, the int32
-quantisation step of a binary ``FileFmtID`` 1 file) or 0.1 % of ``dt``, whichever is larger; the stamps are then
-replaced by the exact grid. Decreasing, repeated or non-uniform time stamps (a gap, a jitter beyond that
-tolerance) raise an error naming the first offending sample: resample such data first (missing samples as NaN
-rows).
+Estimators assume uniform sampling, so every reader returns a record on a uniform grid ``t0 + k dt`` (s). The step
+is inferred from the data (the median of the differences, then a least-squares fit), never from how wide the
+stamps are printed. A file's time stamps must follow the grid to within their own resolution (half a unit of the
+last printed digit of each stamp, the int32 quantisation step of a binary ``FileFmtID`` 1 file) or 0.1 % of ``dt``,
+whichever is larger; quantised stamps are then replaced by the grid, stamps that already are a uniform grid to
+float64 rounding are kept as they are (lossless). Decreasing or repeated stamps, a gap (a step of more than 1.5
+``dt``: the message says how many samples are missing) or a jitter beyond that tolerance raise an error naming the
+first offending sample: resample such data first (missing samples as NaN rows). ``.npz`` records are held to the
+same rule.
+
+Files
+-----
+Only regular files are read: a device (a link to ``/dev/zero``), a FIFO or a socket is refused before anything is
+read, and so is a file larger than the available memory divided by 8 (a reader's worst case per byte).
 
 Missing values
 --------------
@@ -56,6 +64,7 @@ import json
 import math
 import os
 import re
+import stat
 import uuid
 import warnings
 import zipfile
@@ -182,13 +191,105 @@ def _package_version() -> str:
         return "unknown"
 
 
-def _uniform_grid(t_raw: NDArray[np.float64], resolution: float, what: str, *,
+_MEMORY_FACTOR = 8
+"""Bytes of memory a reader may need per byte of file (text lines, parsed floats, the record): a file larger than
+the available memory divided by this is refused before it is read."""
+
+
+def _available_memory() -> int | None:
+    """Bytes of memory available to this process (``MemAvailable``), or None where that is unknown."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return int(os.sysconf("SC_AVPHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+_FILE_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+               (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISSOCK, "a socket"))
+
+
+def _open_regular(p: Path) -> tuple[int, int]:
+    """Open `p` for reading without blocking and check it is a regular file of a size this machine can read.
+
+    Returns the file descriptor (the caller closes it) and the file size in bytes. Raises RecordFileError for a
+    missing file, a directory, a device, a FIFO or socket (never read: ``/dev/zero`` and a pipe have no end), or a
+    file larger than the available memory allows.
+    """
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_BINARY", 0)
+    try:
+        fd = os.open(p, flags)
+    except FileNotFoundError:
+        raise RecordFileError(p, "no such file") from None
+    except IsADirectoryError:
+        raise RecordFileError(p, "is a directory, not a record file") from None
+    except OSError as exc:
+        raise RecordFileError(p, f"cannot open: {exc.strerror or exc}") from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            kind = next((name for test, name in _FILE_KINDS if test(info.st_mode)), "not a regular file")
+            raise RecordFileError(p, f"is {kind}, not a regular file; fowt-env reads records from regular files "
+                                     "only")
+        size = int(info.st_size)
+        available = _available_memory()
+        if available is not None and size * _MEMORY_FACTOR > available:
+            raise RecordFileError(p, f"is {size / 2**30:.3g} GiB, too large to read here ({available / 2**30:.3g} "
+                                     f"GiB of memory available, reading needs up to {_MEMORY_FACTOR}x the file size);"
+                                     " split the file")
+    except BaseException:
+        os.close(fd)
+        raise
+    return fd, size
+
+
+def _read_regular(p: Path) -> bytes:
+    """The bytes of the regular file `p` (see :func:`_open_regular`), read at most to the size checked."""
+    fd, size = _open_regular(p)
+    try:
+        with os.fdopen(fd, "rb", closefd=True) as fh:
+            data = fh.read(size + 1)
+    except OSError as exc:
+        raise RecordFileError(p, f"cannot read: {exc.strerror or exc}") from None
+    if len(data) > size:
+        raise RecordFileError(p, "grew while being read; read a finished file")
+    return data
+
+
+def _check_regular(p: Path) -> None:
+    """:func:`_open_regular`'s checks, for readers that open the file themselves (NumPy, pyarrow)."""
+    fd, _ = _open_regular(p)
+    os.close(fd)
+
+
+def _grid(t0: float, dt: float, n: int) -> NDArray[np.float64]:
+    return t0 + dt * np.arange(n, dtype=np.float64)
+
+
+def _float_noise(t_abs: float, dt: float) -> float:
+    """Float64 rounding (s) of time stamps computed as ``t0 + k*dt``: a few ulps of the largest."""
+    return 8.0 * float(np.finfo(np.float64).eps) * max(t_abs, dt)
+
+
+def _uniform_grid(t_raw: NDArray[np.float64], resolution: float | NDArray[np.float64], what: str, *,
                   rel_tol: float = 1e-3) -> tuple[float, float]:
     """``(t0, dt)`` of the uniform grid that the time stamps `t_raw` (s) follow to within their resolution.
 
-    The tolerance is ``max(2 * resolution, rel_tol * dt)``. Raises ValueError (naming the first bad sample) for
-    missing, decreasing or non-uniform stamps.
+    `resolution` is one unit of the last printed digit of each stamp (an array, one per stamp) or of all of them
+    (a float; 0 for stamps stored exactly). The step is inferred from the data, not from how the stamps are
+    printed: the median of the differences screens every difference (a gap, a jitter or a step back is refused,
+    naming its sample), then a least-squares fit of ``t0 + k dt`` is snapped to the shortest decimals that
+    reproduce every stamp within half its resolution. Each stamp must lie within ``max(resolution / 2,
+    rel_tol * dt)`` of the grid. A resolution coarser than 0.3 ``dt`` (a first stamp printed as ``0``) is capped
+    there: such a stamp cannot tell a grid apart, the others can.
     """
+    t_raw = np.asarray(t_raw, dtype=np.float64)
     n = int(t_raw.size)
     if n < 2:
         raise ValueError(f"{what} holds {n} time step(s); a record needs at least 2")
@@ -196,42 +297,91 @@ def _uniform_grid(t_raw: NDArray[np.float64], resolution: float, what: str, *,
     if bad.any():
         k = int(np.argmax(bad))
         raise ValueError(f"{what}: time stamp {k} is missing or not finite ({float(t_raw[k])!r})")
-    span = float(t_raw[-1] - t_raw[0])
-    if not span > 0.0:
-        raise ValueError(f"{what}: time does not increase (first {float(t_raw[0])!r} s, last "
-                         f"{float(t_raw[-1])!r} s)")
-    dt = span / (n - 1)
+    steps = np.diff(t_raw)
+    back = np.nonzero(~(steps > 0.0))[0]
+    if back.size:
+        k = int(back[0])
+        raise ValueError(f"{what}: time is not increasing at sample {k + 1} "
+                         f"({float(t_raw[k])!r} s, then {float(t_raw[k + 1])!r} s)")
     t_abs = float(np.max(np.abs(t_raw)))
-    noise = 1e-10 * max(t_abs, dt)  # float64 rounding of stamps computed as t0 + k*dt
-    for digits in range(1, 16):  # snap dt to the shortest decimal the stamps cannot tell apart from it
+    dt_med = float(np.median(steps))
+    noise = _float_noise(t_abs, dt_med)
+    res = np.broadcast_to(np.asarray(resolution, dtype=np.float64), (n,))
+    half = 0.5 * res
+    half = np.minimum(half, 0.3 * dt_med) + noise
+    # every step against the median step: names the first gap, jitter or drift
+    step_tol = rel_tol * dt_med + half[:-1] + half[1:]
+    off = np.abs(steps - dt_med) > step_tol
+    if off.any():
+        k = int(np.argmax(off))
+        step = float(steps[k])
+        if step > 1.5 * dt_med:
+            raise ValueError(
+                f"{what}: time has a gap at sample {k + 1}: {float(t_raw[k + 1])!r} s comes {step:.6g} s after "
+                f"{float(t_raw[k])!r} s, about {round(step / dt_med) - 1} missing sample(s) at the median step "
+                f"{dt_med:.6g} s; resample to a uniform grid first (missing samples as NaN rows)")
+        raise ValueError(
+            f"{what}: time step is not uniform: sample {k + 1} at {float(t_raw[k + 1])!r} s comes {step:.6g} s after "
+            f"the previous one, the median step is {dt_med:.6g} s (tolerance {float(step_tol[k]):.3g} s); resample "
+            "to a uniform grid first (missing samples as NaN rows)")
+    # least-squares grid, centred for precision, then the shortest decimals the stamps cannot tell apart from it
+    k_idx = np.arange(n, dtype=np.float64)
+    kc = k_idx - 0.5 * (n - 1)
+    t_mean = float(np.mean(t_raw))
+    dt = float(np.dot(kc, t_raw - t_mean) / np.dot(kc, kc))
+
+    def fits(step: float, within: NDArray[np.float64]) -> tuple[bool, float]:
+        start = float(np.median(t_raw - step * k_idx))
+        return bool(np.all(np.abs(t_raw - (start + step * k_idx)) <= within)), start
+
+    exact, t0 = fits(dt, np.full(n, noise))
+    # stamps stored exactly (shortest decimals, binary floats) only snap off float rounding: "0.0", "0.0125",
+    # "0.025" are not 0.012 s steps printed to 1 ms. Printed (quantised) stamps snap within their resolution to
+    # a step of at most two more decimals than printed and within 3 standard errors of the fitted step: 1 ms
+    # stamps of 60 Hz data are not 0.016667 s steps, 0.1 ms stamps of 160 Hz data are 0.00625 s steps.
+    snap = np.full(n, noise) if exact else half
+    ok = exact or fits(dt, half)[0]
+    if exact:
+        max_digits, max_shift = 16, 2.0 * noise / (n - 1)
+    else:
+        printed = res[res > 0.0]
+        max_digits = 16 if printed.size == 0 else int(round(-math.log10(float(np.median(printed))))) + 2
+        resid = t_raw - (t0 + dt * k_idx)
+        max_shift = (3.0 * math.sqrt(float(np.dot(resid, resid)) / (n - 2) / float(np.dot(kc, kc)))
+                     if n > 2 else math.inf)
+    for digits in range(1, min(max_digits, 16) + 1):
         cand = round(dt, digits)
-        if cand > 0.0 and abs(cand - dt) * (n - 1) <= max(resolution, noise):
-            dt = cand
-            break
-    t0 = float(t_raw[0])
-    snapped = round(t0, 9)
-    if abs(snapped - t0) <= max(resolution, noise):
-        t0 = snapped
-    tol = max(2.0 * resolution, rel_tol * dt) + 1e-9 * t_abs
-    dev = np.abs(t_raw - (t0 + dt * np.arange(n)))
-    if float(dev.max()) > tol:
-        steps = np.diff(t_raw)
-        back = np.nonzero(steps <= -tol)[0]
-        if back.size:
-            k = int(back[0])
-            raise ValueError(f"{what}: time is not increasing at sample {k + 1} "
-                             f"({float(t_raw[k])!r} s, then {float(t_raw[k + 1])!r} s)")
+        if cand > 0.0 and abs(cand - dt) <= max_shift and abs(cand - dt) * (n - 1) <= 2.0 * float(snap.max()):
+            good, start = fits(cand, snap)
+            if good:
+                dt, t0, ok = cand, start, True
+                break
+    if ok:
+        for digits in range(0, 13):
+            cand0 = round(t0, digits)
+            if np.all(np.abs(t_raw - (cand0 + dt * k_idx)) <= snap):
+                t0 = cand0
+                break
+    tol = np.maximum(half, rel_tol * dt + noise)
+    dev = np.abs(t_raw - (t0 + dt * k_idx))
+    if np.any(dev > tol):
         k = int(np.argmax(dev > tol))
         raise ValueError(
             f"{what}: time step is not uniform: sample {k} at {float(t_raw[k])!r} s is {dev[k]:.3g} s off the grid "
-            f"{t0!r} + k*{dt!r} s (tolerance {tol:.3g} s); resample to a uniform grid first (missing samples as "
-            "NaN rows)"
+            f"{t0!r} + k*{dt!r} s (tolerance {float(tol[k]):.3g} s); resample to a uniform grid first (missing "
+            "samples as NaN rows)"
         )
     return t0, dt
 
 
-def _grid(t0: float, dt: float, n: int) -> NDArray[np.float64]:
-    return t0 + dt * np.arange(n, dtype=np.float64)
+def _time_axis(t_raw: NDArray[np.float64], resolution: float | NDArray[np.float64], what: str) -> NDArray[np.float64]:
+    """The uniform time axis (s) of stamps `t_raw`: the stamps themselves if they already are a uniform grid to
+    float64 rounding (lossless), else the grid ``t0 + k dt`` of :func:`_uniform_grid` they follow."""
+    t_raw = np.asarray(t_raw, dtype=np.float64)
+    t0, dt = _uniform_grid(t_raw, resolution, what)
+    grid = _grid(t0, dt, t_raw.size)
+    noise = _float_noise(float(np.max(np.abs(t_raw))), dt)
+    return t_raw.copy() if float(np.max(np.abs(t_raw - grid))) <= noise else grid
 
 
 def _token_resolution(token: str) -> float:
@@ -243,6 +393,22 @@ def _token_resolution(token: str) -> float:
     decimals = len(m.group(2))
     exponent = int(m.group(3)) if m.group(3) else 0
     return 10.0 ** (exponent - decimals)
+
+
+def _token_resolutions(tokens: NDArray[np.str_]) -> NDArray[np.float64]:
+    """:func:`_token_resolution` of each printed number (vectorised for plain decimals)."""
+    cells = np.char.strip(np.asarray(tokens, dtype=str))
+    out = np.empty(cells.shape, dtype=np.float64)
+    if cells.size == 0:
+        return out
+    lower = np.char.lower(cells)
+    has_exp = (np.char.find(lower, "e") >= 0) | (np.char.find(lower, "d") >= 0)
+    dot = np.char.find(cells, ".")
+    decimals = np.where(dot >= 0, np.char.str_len(cells) - dot - 1, 0)
+    out[:] = 10.0 ** (-decimals.astype(np.float64))
+    for i in np.nonzero(has_exp)[0]:
+        out[i] = _token_resolution(str(cells[i]))
+    return out
 
 
 def _check_uniform_for_writing(record: Record) -> tuple[float, float]:
@@ -300,14 +466,7 @@ def read_openfast(path: str | os.PathLike[str]) -> Record:
     True
     """
     p = Path(path)
-    try:
-        data = p.read_bytes()
-    except FileNotFoundError:
-        raise RecordFileError(p, "no such file") from None
-    except IsADirectoryError:
-        raise RecordFileError(p, "is a directory, not an OpenFAST output file") from None
-    except OSError as exc:
-        raise RecordFileError(p, f"cannot read: {exc.strerror or exc}") from None
+    data = _read_regular(p)
     try:
         order = _binary_byte_order(data)
         if order is not None:
@@ -465,13 +624,13 @@ def _parse_openfast_text(data: bytes):
         table, overflow = _parse_rows_slowly(body, len(names), delimiter, start)
     if table.shape[1] != len(names):
         raise ValueError(f"has {len(names)} channel names (with Time) but {table.shape[1]} columns of numbers")
-    time_tokens = [body[0].split(delimiter)[0], body[-1].split(delimiter)[0]]
-    resolution = max(_token_resolution(tok) for tok in time_tokens)
-    t0, dt = _uniform_grid(table[:, 0], resolution, "the Time column")
+    time_tokens = np.array([line.split(delimiter, 1)[0] if delimiter else (line.split(None, 1) or [""])[0]
+                            for line in body], dtype=str)
+    t = _time_axis(table[:, 0], _token_resolutions(time_tokens), "the Time column")
     meta: dict[str, Any] = {"format": "openfast-text", "description": description}
     if overflow:
         meta["overflow_values"] = overflow
-    return _grid(t0, dt, table.shape[0]), table[:, 1:], names[1:], units[1:], meta
+    return t, table[:, 1:], names[1:], units[1:], meta
 
 
 def _parse_rows_slowly(body: list[str], n_cols: int, delimiter: str | None, first_line: int):
@@ -611,9 +770,9 @@ def _write_openfast_text(record: Record, tmp: Path, names: list[str], units: lis
                          precision: int) -> None:
     t = record.t
     dt = record.dt
-    decimals = 12
-    for d in range(4, 13):
-        if float(np.max(np.abs(t - np.round(t, d)))) <= 1e-4 * dt:
+    decimals = 15
+    for d in range(4, 16):  # enough digits that a reader recovers dt to float precision, not only to 0.01 %
+        if float(np.max(np.abs(t - np.round(t, d)))) <= max(1e-12 * dt, _float_noise(float(np.max(np.abs(t))), dt)):
             decimals = d
             break
     width = max(10, decimals + 6)
@@ -739,8 +898,9 @@ def _float_column(col: _Column, what: str) -> NDArray[np.float64]:
     raise ValueError(f"{what} {col.raw!r} is not numeric (type {v.dtype})")
 
 
-def _time_seconds(col: _Column) -> tuple[NDArray[np.float64], float, str | None]:
-    """Seconds, their resolution (s) and the ISO start time (datetime columns only)."""
+def _time_seconds(col: _Column) -> tuple[NDArray[np.float64], float | NDArray[np.float64], str | None]:
+    """Seconds, their resolution (s; one per printed stamp, or one for all) and the ISO start time (datetime
+    columns only)."""
     v = col.values
     if v.dtype.kind == "M":
         ns = v.astype("datetime64[ns]")
@@ -758,8 +918,7 @@ def _time_seconds(col: _Column) -> tuple[NDArray[np.float64], float, str | None]
         except ValueError:
             seconds = None
         if seconds is not None:
-            tokens = [c for c in (cells[0], cells[-1]) if c]
-            return seconds, max((_token_resolution(c) for c in tokens), default=0.0), None
+            return seconds, _token_resolutions(cells), None
         try:
             with warnings.catch_warnings():  # numpy warns on UTC offsets (+01:00), which it applies
                 warnings.simplefilter("ignore")
@@ -789,7 +948,7 @@ def _parses_as_time(cell: str) -> bool:
 
 
 def _read_csv_columns(path: Path) -> list[_Column]:
-    text = path.read_text(encoding="utf-8-sig")
+    text = _read_regular(path).decode("utf-8-sig")
     lines = [ln for ln in text.splitlines() if not ln.lstrip().startswith("#")]
     while lines and not lines[0].strip():
         lines.pop(0)
@@ -820,6 +979,7 @@ def _read_csv_columns(path: Path) -> list[_Column]:
 
 def _read_parquet_columns(path: Path) -> tuple[list[_Column], dict[str, Any] | None]:
     pa = _require_pyarrow(path)
+    _check_regular(path)
     try:
         table = pa.parquet.read_table(path)
     except (pa.lib.ArrowException, OSError) as exc:
@@ -1039,11 +1199,12 @@ def _read_table(p: Path, channel_map: Any, time_column: str | None, dt: float | 
     start_time = None
     if time_col is not None:
         seconds, resolution, start_time = _time_seconds(time_col)
-        t0, step = _uniform_grid(seconds, resolution, f"time column {time_col.raw!r}")
+        t = _time_axis(seconds, resolution, f"time column {time_col.raw!r}")
+        step = float(t[1] - t[0]) if n == 2 else float((t[-1] - t[0]) / (n - 1))
         if dt is not None and abs(step - float(dt)) > 1e-3 * float(dt):
             raise ValueError(f"dt={dt!r} s disagrees with the time column's step {step!r} s")
     else:
-        t0, step = 0.0, float(dt)  # type: ignore[arg-type]
+        t = _grid(0.0, float(dt), n)  # type: ignore[arg-type]
 
     final_names = [c.name for c in columns]
     unit_list = [c.unit if c.unit is not None else UNITS.get(c.name, "") for c in columns]
@@ -1070,7 +1231,7 @@ def _read_table(p: Path, channel_map: Any, time_column: str | None, dt: float | 
             meta["unknown_channels"] = unknown
         if start_time is not None:
             meta["start_time"] = start_time
-    return Record(_grid(t0, step, n), y, final_names, unit_list, meta)
+    return Record(t, y, final_names, unit_list, meta)
 
 
 def write_table(record: Record, path: str | os.PathLike[str]) -> Path:
@@ -1194,14 +1355,17 @@ def load_channel_map(path: str | os.PathLike[str]) -> dict[str, str]:
 
 
 def _check_readable(p: Path) -> str:
-    if not p.exists():
+    if not os.path.lexists(p):
         raise RecordFileError(p, "no such file")
+    if not p.exists():
+        raise RecordFileError(p, "is a broken symbolic link (no such file)")
     if p.is_dir():
         raise RecordFileError(p, "is a directory, not a record file")
     ext = p.suffix.lower()
     if ext not in READ_EXTENSIONS:
         raise RecordFileError(p, f"unknown file extension {ext or '(none)'!r}; fowt-env reads "
                                  f"{', '.join(READ_EXTENSIONS)}")
+    _check_regular(p)
     return ext
 
 
@@ -1261,6 +1425,10 @@ def load_record(
             message = str(exc)
             message = message[len(str(p)):].lstrip(": ") if message.startswith(str(p)) else message
             raise RecordFileError(p, message or type(exc).__name__) from None
+        try:  # Record allows any increasing t; every reader here promises a uniform grid
+            _uniform_grid(record.t, 0.0, "the time axis t")
+        except ValueError as exc:
+            raise RecordFileError(p, str(exc)) from None
     else:
         record = read_openfast(p)
     if channel_map:

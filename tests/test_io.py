@@ -121,7 +121,7 @@ def test_reads_openfast_text_with_rounded_time_and_fortran_fields(tmp_path):
 
 
 @pytest.mark.parametrize(("edit", "message"), [
-    (lambda rows: rows[:5] + rows[6:], "not uniform"),                        # a missing sample
+    (lambda rows: rows[:5] + rows[6:], "gap at sample 5"),                    # a missing sample
     (lambda rows: rows[:5] + [rows[6], rows[5]] + rows[7:], "not increasing"),  # two swapped samples
 ])
 def test_non_uniform_or_decreasing_time_is_a_clear_error(tmp_path, edit, message):
