@@ -16,6 +16,7 @@ Examples
     fowt-env compare --scenario A,B,C --estimators hold,kalman,dmd,koopman --json table.json --plot figs
     fowt-env compare --estimators dmd --update-interval sweep --plot figs   # where accuracy collapses
     fowt-env campaign --cases 1-12 --seeds 0-4 --scenario random --out camp --scheduler local:2
+    fowt-env validate --seeds 4 --json fidelity.json --plot figs   # the surrogate against OpenFAST
 """
 
 from __future__ import annotations
@@ -179,6 +180,21 @@ def _cmd_discrepancy(args: argparse.Namespace) -> int:
     if args.plot:
         print(f"wrote {rep.plot(Path(args.plot) / 'discrepancy.png')}")
     return 0
+
+
+def _cmd_validate(args: argparse.Namespace) -> int:
+    from .validation import validate
+
+    progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
+    rep = validate(args.reference, seeds=args.seeds, duration=args.duration, runs=args.runs, plot_dir=args.plot,
+                   progress=progress)
+    print(rep.summary(graded_only=not args.all_channels), end="")
+    if args.json:
+        rep.to_json(args.json)
+        print(f"wrote {args.json}")
+    if rep.figures:
+        print(f"wrote {len(rep.figures)} figure(s) to {args.plot}")
+    return 1 if args.strict and not rep.passed else 0
 
 
 def _load_record(path: str, channel_map: str | None = None):
@@ -637,6 +653,31 @@ def build_parser() -> argparse.ArgumentParser:
                    help="progress bar on stderr (default: when stderr is a terminal)")
     g.add_argument("--fresh", action="store_true", help="forget the results already in --out and start again")
     g.set_defaults(func=_cmd_campaign)
+
+    vd = sub.add_parser(
+        "validate", help="fidelity against OpenFAST: free decays, means, std per band, DELs, PSD overlays",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Simulate the surrogate under the conditions of each OpenFAST reference run (its case.json) with "
+                    "several seeds and compare: free-decay periods and damping, means, standard deviations in total "
+                    "and per band (<0.05, 0.05-0.25, 0.4-0.6 Hz), tower-base DELs (rainflow, m = 4), with the "
+                    "tolerances of issue 15. Informational: exit status 0 unless --strict.",
+        epilog="Examples:\n"
+               "  fowt-env validate                                  # the packaged OC3 Hywind runs, 8 seeds\n"
+               "  fowt-env validate --seeds 2 --duration 200 --runs c_op12 b_decay   # quick look\n"
+               "  fowt-env validate ../shared/reference/openfast/runs --json fidelity.json --plot figs")
+    vd.add_argument("reference", nargs="?", default=None,
+                    help="folder of OpenFAST outputs (.outb/.out/.npz/.csv/.parquet) with <run>.case.json sidecars "
+                         "(default: the compact OC3 Hywind runs shipped with fowt-env)")
+    vd.add_argument("--seeds", type=int, default=8, help="surrogate seeds per operating run (default 8)")
+    vd.add_argument("--duration", type=float, default=None,
+                    help="simulated seconds per operating run (default: the reference's, 600 s)")
+    vd.add_argument("--runs", nargs="+", default=None, metavar="NAME",
+                    help="only these runs (names, prefixes or glob patterns; default all)")
+    vd.add_argument("--json", default=None, metavar="OUT", help="write the full report as JSON")
+    vd.add_argument("--plot", default=None, metavar="DIR", help="folder for one figure per run (PSD overlays)")
+    vd.add_argument("--all-channels", action="store_true", help="list every compared channel, not only graded ones")
+    vd.add_argument("--strict", action="store_true", help="exit with status 1 if a graded check fails")
+    vd.set_defaults(func=_cmd_validate)
 
     m = sub.add_parser("modes", help="modal frequencies and damping of the linearised model")
     m.add_argument("--case", default=None, help="OLC number (default: parked, still water)")
