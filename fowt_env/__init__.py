@@ -12,11 +12,16 @@ All take the keyword arguments of :class:`fowt_env.env.SparEnv`; episodes are tr
 to change it).
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 from gymnasium.envs.registration import register, registry
 
-from . import faults
-from .env import RewardConfig, SparEnv
-from .wrappers import VirtualSensorWrapper
+if TYPE_CHECKING:  # imported on first use (below), so that ``fowt-env --help`` does not load the physics
+    from . import faults
+    from .env import RewardConfig, SparEnv
+    from .wrappers import VirtualSensorWrapper
 
 __version__ = "0.1.0"
 __all__ = ["SparEnv", "RewardConfig", "VirtualSensorWrapper", "faults", "make_scenario_env", "ENV_IDS"]
@@ -24,8 +29,31 @@ __all__ = ["SparEnv", "RewardConfig", "VirtualSensorWrapper", "faults", "make_sc
 MAX_EPISODE_STEPS = 48_000
 
 
+_LAZY = {"SparEnv": ".env", "RewardConfig": ".env", "VirtualSensorWrapper": ".wrappers", "faults": ".faults"}
+
+
+def __getattr__(name: str):
+    """``fowt_env.SparEnv`` and the rest of ``__all__`` are imported when first used: the command line's
+    ``--help`` and ``--version`` then answer without importing SciPy, Numba and the surrogate."""
+    if name not in _LAZY:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
+
+    module = importlib.import_module(_LAZY[name], __name__)
+    value = module if name == "faults" else getattr(module, name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
+
 def make_scenario_env(name: str, **kwargs) -> SparEnv:
     """A :class:`SparEnv` set up as the paper's scenario ``name`` (its OLC, FA plane, fixed hidden mask)."""
+    from . import faults
+    from .env import SparEnv
+
     scenario = faults.Scenario(name)
     extra = kwargs.pop("faults", None)
     fault_list = [scenario] + faults.as_fault_list(extra)
@@ -36,6 +64,8 @@ def make_scenario_env(name: str, **kwargs) -> SparEnv:
 
 def _linear_env(**kwargs) -> SparEnv:
     import surrogates
+
+    from .env import SparEnv
 
     kwargs.setdefault("model", surrogates.FOWTModel(effects="none"))
     return SparEnv(**kwargs)

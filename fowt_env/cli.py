@@ -23,14 +23,64 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import difflib
 import json
+import re
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["main"]
+__all__ = ["main", "build_parser"]
+
+
+class _UsageError(Exception):
+    """A bad command-line value found after parsing: reported like argparse's own errors (the subcommand's usage,
+    then ``fowt-env CMD: error: ...``, exit status 2)."""
+
+
+class _HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Keeps the examples' line breaks and shows every option's default (unless its help already states it)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if (action.option_strings and not action.required and "default" not in text
+                and not any(action.default is v for v in (None, False, argparse.SUPPRESS))):
+            text += " (default: %(default)s)"
+        return text
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with the defaults shown in every help and a "did you mean" on misspelt options and commands."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs.setdefault("formatter_class", _HelpFormatter)
+        super().__init__(*args, **kwargs)
+
+    def error(self, message: str):  # type: ignore[override]
+        self.print_usage(sys.stderr)
+        self.exit(2, f"{self.prog}: error: {message}{self._suggestion(message)}\n")
+
+    def _suggestion(self, message: str) -> str:
+        choice = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
+        if choice:
+            wrong, known = choice.group(1), [c.strip(" '") for c in choice.group(2).split(",")]
+        elif message.startswith("unrecognized arguments:"):
+            words = [w.split("=")[0] for w in message.split(":", 1)[1].split() if w.startswith("-")]
+            if not words:
+                return ""
+            wrong, known = words[0], [o for o in self._option_string_actions if o.startswith("--")]
+        else:
+            return ""
+        close = difflib.get_close_matches(wrong, known, n=1, cutoff=0.6)
+        return f" (did you mean {close[0]}?)" if close else ""
+
+
+def _plane(text: str) -> str:
+    """``--plane`` in any case: FA, SS (or all where offered)."""
+    t = text.strip()
+    return t.upper() if t.upper() in ("FA", "SS") else t.lower()
 
 
 def _parse_effects(spec: str | None) -> str | dict[str, float]:
@@ -42,18 +92,23 @@ def _parse_effects(spec: str | None) -> str | dict[str, float]:
         name, _, value = item.partition("=")
         try:
             out[name.strip()] = float(value) if value else 1.0
-        except ValueError as exc:
-            raise SystemExit(f"fowt-env: --effects: strength of {name!r} is not a number: {value!r}") from exc
+        except ValueError:
+            raise _UsageError(f"--effects: strength of {name!r} is not a number: {value!r}") from None
     return out
 
 
-def _case(arg: str):
+def _case(arg: str | int):
+    """The load case of ``--case`` (an OLC number); a usage error naming the valid numbers otherwise."""
     import surrogates
 
+    known = sorted(surrogates.LOAD_CASES)
     try:
-        return surrogates.load_case(int(arg))
-    except ValueError as exc:
-        raise SystemExit(f"fowt-env: --case: {exc}") from exc
+        n = int(arg)
+    except (TypeError, ValueError):
+        n = None
+    if n not in surrogates.LOAD_CASES:
+        raise _UsageError(f"--case: expected an OLC number from {known[0]} to {known[-1]}, got {arg!r}")
+    return surrogates.load_case(n)
 
 
 def _save_record(rec, path: str | Path) -> Path:
@@ -64,17 +119,28 @@ def _save_record(rec, path: str | Path) -> Path:
     return save_record(rec, path if path.suffix else path.with_suffix(".npz"))
 
 
+def _timed_simulation(model, case, **kwargs):
+    """``surrogates.simulate(model, case, **kwargs)`` and its own wall time: the set-up that a first call in a
+    process pays once (the model's matrices, loading the compiled kernel) is done by a two-sample run first, so
+    that the "x real time" figure is the simulation's speed, not the cost of starting the program."""
+    import surrogates
+
+    warm = {k: v for k, v in kwargs.items() if k in ("dt", "seed", "noise")}
+    surrogates.simulate(model, case, duration=2.0 * kwargs.get("dt", 0.0125), transient=0.0, **warm)
+    t0 = time.perf_counter()
+    rec = surrogates.simulate(model, case, **kwargs)
+    return rec, time.perf_counter() - t0
+
+
 def _cmd_simulate(args: argparse.Namespace) -> int:
     import surrogates
 
     model = surrogates.FOWTModel(_parse_effects(args.effects))
-    t0 = time.perf_counter()
-    rec = surrogates.simulate(model, _case(args.case), duration=args.duration, dt=args.dt, seed=args.seed,
-                              noise=not args.no_noise)
-    wall = time.perf_counter() - t0
+    rec, wall = _timed_simulation(model, _case(args.case), duration=args.duration, dt=args.dt, seed=args.seed,
+                                  noise=not args.no_noise)
     path = _save_record(rec, args.out)
     print(f"wrote {path}: {rec.n_samples} samples x {rec.n_channels} channels, {rec.duration:.1f} s simulated "
-          f"in {wall:.2f} s ({rec.duration / wall:.0f}x real time)")
+          f"in {wall:.2f} s ({rec.duration / max(wall, 1e-9):.0f}x real time)")
     return 0
 
 
@@ -90,14 +156,30 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     return 0
 
 
+_FAULT_FORMS = {  # kind: (form, example)
+    "dropout": ("dropout:RATE:BURST_S", "dropout:0.1:2"),
+    "scenario": ("scenario:A|B|C", "scenario:B"),
+    "mask": ("mask:CH,CH", "mask:TwHt1ALxt,TwHt9MLyt"),
+    "stuck": ("stuck:CH:START_S", "stuck:TwHt9ALxt:30 (frozen from t = 30 s on)"),
+    "spike": ("spike:RATE:AMP", "spike:0.001:0.5"),
+    "drift": ("drift:CH:RATE", "drift:TwHt9ALxt:0.001"),
+    "noiseburst": ("noiseburst:CH:STD:START_S:DURATION_S", "noiseburst:TwHt9ALxt:0.1:30:5"),
+}
+
+
 def _parse_faults(specs: list[str]):
-    """``dropout:RATE:BURST_S``, ``scenario:A``, ``mask:CH1,CH2``, ``stuck:CH:START``, ``spike:RATE:AMP``,
-    ``drift:CH:RATE``, ``noiseburst:CH:STD:START:DURATION``."""
+    """``dropout:RATE:BURST_S``, ``scenario:A``, ``mask:CH1,CH2``, ``stuck:CH:START_S``, ``spike:RATE:AMP``,
+    ``drift:CH:RATE``, ``noiseburst:CH:STD:START_S:DURATION_S``; every field is required."""
     from . import faults as F
 
     out = []
     for spec in specs:
         kind, *args = spec.split(":")
+        if kind not in _FAULT_FORMS:
+            raise _UsageError(f"--fault {spec!r}: unknown kind {kind!r} (one of {', '.join(_FAULT_FORMS)})")
+        form, example = _FAULT_FORMS[kind]
+        if len(args) != form.count(":") or not all(a.strip() for a in args):
+            raise _UsageError(f"--fault {spec!r}: expected {form}, e.g. {example}")
         try:
             if kind == "dropout":
                 out.append(F.RandomDropout(float(args[0]), float(args[1])))
@@ -106,7 +188,7 @@ def _parse_faults(specs: list[str]):
             elif kind == "mask":
                 out.append(F.FixedMask(args[0].split(",")))
             elif kind == "stuck":
-                out.append(F.Stuck(args[0].split(","), start=float(args[1]) if len(args) > 1 else 0.0))
+                out.append(F.Stuck(args[0].split(","), start=float(args[1])))
             elif kind == "spike":
                 out.append(F.Spike(float(args[0]), float(args[1])))
             elif kind == "drift":
@@ -114,11 +196,8 @@ def _parse_faults(specs: list[str]):
             elif kind == "noiseburst":
                 out.append(F.NoiseBurst(args[0].split(","), std=float(args[1]), start=float(args[2]),
                                         duration=float(args[3])))
-            else:
-                raise SystemExit(f"fowt-env: --fault: unknown kind {kind!r} (dropout, scenario, mask, stuck, spike, "
-                                 "drift, noiseburst)")
         except (IndexError, ValueError) as exc:
-            raise SystemExit(f"fowt-env: --fault {spec!r}: {exc or 'missing arguments'}") from exc
+            raise _UsageError(f"--fault {spec!r}: {exc or 'missing arguments'} (expected {form})") from None
     return out
 
 
@@ -170,8 +249,11 @@ def _cmd_discrepancy(args: argparse.Namespace) -> int:
     measured = _load_record(args.measured, args.channel_map)
     model = surrogates.FOWTModel(_parse_effects(args.model_effects))
     cands = args.candidates.split(",") if args.candidates else None
+    case = _record_case(measured, args.case)
+    if case is None:
+        raise _UsageError(f"{args.measured} does not state its load case: give --case (an OLC number)")
     t0 = time.perf_counter()
-    rep = discrepancy.run(measured, model, _case(args.case), seed=args.seed, candidates=cands, n_seeds=args.seeds)
+    rep = discrepancy.run(measured, model, case, seed=args.seed, candidates=cands, n_seeds=args.seeds)
     print(rep.summary())
     print(f"({time.perf_counter() - t0:.1f} s)")
     if args.json:
@@ -199,13 +281,34 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 
 def _load_record(path: str, channel_map: str | None = None):
     """Any record file fowt_env.io reads (.npz, .out, .outb, .csv, .parquet); one-line exit on any problem."""
+    import zipfile
+
     from .io import load_channel_map, load_record
 
+    p = Path(path)
+    if p.suffix.lower() == ".npz" and p.is_file() and not zipfile.is_zipfile(p):
+        # numpy reads a non-zip file as a pickle and answers with advice on unsafe loading: never relay that
+        raise SystemExit(f"fowt-env: {path}: not an .npz record (an .npz file is a zip archive of arrays, as "
+                         "written by fowt-env simulate/episode or Record.save)")
     try:
         mapping = load_channel_map(channel_map) if channel_map else None
         return load_record(path, channel_map=mapping, unknown_channels="keep")
     except ValueError as exc:
-        raise SystemExit(f"fowt-env: {exc}") from None
+        message = str(exc)
+        if "pickle" in message:
+            message = f"{path}: not a record file this program can read safely"
+        raise SystemExit(f"fowt-env: {message}") from None
+
+
+def _record_case(rec, case_arg: str | None):
+    """The load case of ``--case`` if given, else the record's own (its header's ``case``), else None."""
+    import surrogates
+
+    if case_arg is not None:
+        return _case(case_arg)
+    if isinstance(rec.meta.get("case"), dict):
+        return surrogates.LoadCase.from_dict(rec.meta["case"])
+    return None
 
 
 def _identification_reference(rec, case_arg: str | None, plane: str | None, effects: str):
@@ -214,11 +317,8 @@ def _identification_reference(rec, case_arg: str | None, plane: str | None, effe
 
     from .identification import model_reference
 
-    if case_arg is not None:
-        case = _case(case_arg)
-    elif isinstance(rec.meta.get("case"), dict):
-        case = surrogates.LoadCase.from_dict(rec.meta["case"])
-    else:
+    case = _record_case(rec, case_arg)
+    if case is None:
         return None
     return model_reference(surrogates.FOWTModel(_parse_effects(effects)), case, plane=plane)
 
@@ -349,10 +449,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     modes = model.modal_analysis()
     print("\nModal analysis (parked, still water):")
     print(modes)
-    t0 = time.perf_counter()
-    rec = surrogates.simulate(model, case, duration=args.duration, dt=0.0125, seed=args.seed)
-    wall = time.perf_counter() - t0
-    print(f"\nSimulated {rec.duration:.0f} s at 80 Hz in {wall:.2f} s ({rec.duration / wall:.0f}x real time)")
+    rec, wall = _timed_simulation(model, case, duration=args.duration, dt=0.0125, seed=args.seed)
+    print(f"\nSimulated {rec.duration:.0f} s at 80 Hz in {wall:.2f} s ({rec.duration / max(wall, 1e-9):.0f}x real "
+          "time)")
     print(_stats_table(rec, ["PtfmSurge", "PtfmPitch", "PtfmYaw", "RotSpeed", "TwHt1MLyt", "TwHt1MLxt",
                              "TwHt9ALxt", "TwHt9ALyt", "Wave1Elev", "Wind1VelX"]))
     path = rec.save(out / f"{case.name.lower()}_seed{args.seed}.npz")
@@ -482,16 +581,22 @@ def _cmd_campaign(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser (exposed for tests and docs)."""
-    p = argparse.ArgumentParser(prog="fowt-env", description=__doc__.split("Examples")[0].strip(),
-                                formatter_class=argparse.RawDescriptionHelpFormatter,
-                                epilog="Examples:\n" + __doc__.split("::")[1])
-    sub = p.add_subparsers(dest="command", required=True)
+    from . import __version__
+
+    p = _Parser(prog="fowt-env", description=__doc__.split("Examples")[0].strip().replace("``", ""),
+                epilog="Examples:\n" + __doc__.split("::")[1])
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
+    p.subcommands = sub.choices  # type: ignore[attr-defined]
+    seed_help = "seed of waves, wind, rotor azimuth and sensor noise (same seed, same record)"
+    effects_help = "model effects: 'all', 'none' or name=strength,... (others nominal)"
+    dt_help = "sample time in s (0.0125 = 80 Hz)"
 
     d = sub.add_parser("demo", help="simulate an OLC, print modal frequencies and statistics, plot PSDs")
     d.add_argument("--out", default="fowt_demo", help="output folder (default: ./fowt_demo)")
     d.add_argument("--case", default="7", help="OLC number 1-12 (default 7: Hs 3 m, Tp 10 s, rated wind)")
     d.add_argument("--duration", type=float, default=600.0, help="simulated seconds (default 600)")
-    d.add_argument("--seed", type=int, default=0)
+    d.add_argument("--seed", type=int, default=0, help=seed_help)
     d.add_argument("--skip-discrepancy", action="store_true", help="skip the discrepancy round trip")
     d.set_defaults(func=_cmd_demo)
 
@@ -499,8 +604,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--case", default="7", help="OLC number 1-12")
     s.add_argument("--duration", type=float, default=600.0, help="seconds (default 600)")
     s.add_argument("--dt", type=float, default=0.0125, help="sample time in s (default 0.0125 = 80 Hz)")
-    s.add_argument("--seed", type=int, default=0)
-    s.add_argument("--effects", default="all", help="'all', 'none' or name=strength,... (others nominal)")
+    s.add_argument("--seed", type=int, default=0, help=seed_help)
+    s.add_argument("--effects", default="all", help=effects_help)
     s.add_argument("--no-noise", action="store_true", help="noise-free sensors")
     s.add_argument("--out", required=True, help="output file: .npz (lossless), .out/.outb (OpenFAST), .csv or .parquet")
     s.set_defaults(func=_cmd_simulate)
@@ -508,13 +613,14 @@ def build_parser() -> argparse.ArgumentParser:
     e = sub.add_parser("episode", help="run an environment episode under sensor faults and save the records")
     e.add_argument("--case", default="7", help="OLC number 1-12")
     e.add_argument("--duration", type=float, default=600.0, help="seconds (default 600)")
-    e.add_argument("--dt", type=float, default=0.0125)
-    e.add_argument("--plane", choices=["FA", "SS"], default=None, help="18 channels of one plane (default all 36)")
+    e.add_argument("--dt", type=float, default=0.0125, help=dt_help)
+    e.add_argument("--plane", type=_plane, choices=["FA", "SS"], default=None,
+                   help="18 channels of one plane, FA or SS in any case (default all 36)")
     e.add_argument("--fault", action="append", metavar="SPEC",
-                   help="repeatable: dropout:RATE:BURST_S | scenario:A|B|C | mask:CH,CH | stuck:CH:START | "
-                        "spike:RATE:AMP | drift:CH:RATE | noiseburst:CH:STD:START:DURATION")
-    e.add_argument("--effects", default="all")
-    e.add_argument("--seed", type=int, default=0)
+                   help="repeatable: " + " | ".join(form for form, _ in _FAULT_FORMS.values())
+                        + " (times and durations in s, every field required)")
+    e.add_argument("--effects", default="all", help=effects_help)
+    e.add_argument("--seed", type=int, default=0, help="seed of the episode (physics and faults)")
     e.add_argument("--out", required=True, help="output .npz (the truth goes to *_truth.npz)")
     e.set_defaults(func=_cmd_episode)
 
@@ -523,11 +629,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="measured record: .npz (fowt-env), OpenFAST .out/.outb, or .csv/.parquet field data")
     q.add_argument("--channel-map", default=None, metavar="FILE.json",
                    help='JSON object renaming file columns to channel names, e.g. {"acc_top_x": "TwHt9ALxt"}')
-    q.add_argument("--case", required=True, help="OLC number of the measured conditions")
+    q.add_argument("--case", default=None,
+                   help="OLC number of the measured conditions (default: the record's own case, if it states one)")
     q.add_argument("--model-effects", default="all", help="candidate model: 'all', 'none' or name=strength,...")
     q.add_argument("--candidates", default=None, help="comma-separated effects to consider (default all)")
     q.add_argument("--seeds", type=int, default=4, help="model simulations per setting (default 4)")
-    q.add_argument("--seed", type=int, default=None)
+    q.add_argument("--seed", type=int, default=None,
+                   help="first seed of the model simulations (default 1000; the next --seeds - 1 follow)")
     q.add_argument("--json", default=None, help="write the report as JSON")
     q.add_argument("--plot", default=None, help="folder for the figure")
     q.set_defaults(func=_cmd_discrepancy)
@@ -536,14 +644,14 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("record", help="record file: .npz (fowt-env), OpenFAST .out/.outb, or .csv/.parquet field data")
     i.add_argument("--channel-map", default=None, metavar="FILE.json",
                    help='JSON object renaming file columns to channel names, e.g. {"acc_top_x": "TwHt9ALxt"}')
-    i.add_argument("--plane", choices=["FA", "SS"], default=None,
-                   help="use the 18 channels of one plane (default: all tower channels)")
+    i.add_argument("--plane", type=_plane, choices=["FA", "SS"], default=None,
+                   help="use the 18 channels of one plane, FA or SS in any case (default: all tower channels)")
     i.add_argument("--channels", default=None, help="comma-separated channels (overrides --plane)")
     i.add_argument("--delays", default="2.5", help="Hankel delay: seconds (e.g. 2.5, default) or samples (60)")
     i.add_argument("--rank", default="24", help="DMD rank: int, energy fraction (0.99) or 'auto'")
     i.add_argument("--case", default=None,
                    help="OLC of the linear reference (default: the record's own case, if it has one)")
-    i.add_argument("--effects", default="all", help="effects of the reference model")
+    i.add_argument("--effects", default="all", help="effects of the reference model: " + effects_help)
     i.add_argument("--no-reference", action="store_true", help="do not compare with the linearised model")
     i.add_argument("--no-ssi", action="store_true", help="skip SSI-COV")
     i.add_argument("--rotor-speed", default="auto", metavar="CHANNEL",
@@ -555,7 +663,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     v = sub.add_parser(
         "sense", help="virtual sensing of one record: fill its lost tower channels with a trained estimator",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=_HelpFormatter,
         description="Reconstruct the lost (NaN) or --hide'n tower channels of a record with a virtual sensor "
                     "(dmd, kalman, koopman, hold), trained on your own complete records (--train) or on the "
                     "surrogate's training set (the paper's OLCs). Writes the reconstruction (and its std for "
@@ -568,7 +676,8 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("record", help="record file: .npz, OpenFAST .out/.outb, .csv/.parquet (NaN = lost)")
     v.add_argument("--estimator", default="dmd", help="dmd (default), kalman, koopman or hold")
     v.add_argument("--hide", default=None, help="comma-separated channels to lose on purpose")
-    v.add_argument("--plane", choices=["FA", "SS", "all"], default="FA", help="channels to sense (default FA)")
+    v.add_argument("--plane", type=_plane, choices=["FA", "SS", "all"], default="FA",
+                   help="channels to sense: FA, SS (any case) or all (default FA)")
     v.add_argument("--channels", default=None, help="comma-separated channels instead of a plane (needs --train)")
     v.add_argument("--train", nargs="+", default=None, metavar="FILE",
                    help="complete training records of the same channels (default: the surrogate training set)")
@@ -587,7 +696,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     c = sub.add_parser(
         "compare", help="virtual sensing: score estimators on hidden channels of unseen load cases (R2, NRMSE)",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=_HelpFormatter,
         description="Train virtual sensors on some OLCs, hide channels of unseen OLCs/seeds (the seed paper's "
                     "scenarios A, B, C or random dropouts), and report R2 and NRMSE per hidden channel (physical and "
                     "band-passed), the 95 % interval coverage and the cost per sample.",
@@ -612,7 +721,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--train-duration", type=float, default=300.0, help="seconds per training record (default 300)")
     c.add_argument("--train-seed", type=int, default=1000,
                    help="the training record of OLC c uses seed TRAIN_SEED + c (default 1000)")
-    c.add_argument("--plane", choices=["FA", "SS", "all"], default="FA",
+    c.add_argument("--plane", type=_plane, choices=["FA", "SS", "all"], default="FA",
                    help="the 18 channels of one plane, or all 36 tower channels (default FA)")
     c.add_argument("--dropout-rate", type=float, default=0.2, help="random scenario: lost fraction (default 0.2)")
     c.add_argument("--dropout-burst", type=float, default=2.0, help="random scenario: mean burst in s (default 2)")
@@ -632,7 +741,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.set_defaults(func=_cmd_compare)
 
     g = sub.add_parser(
-        "campaign", parents=[c], add_help=False, formatter_class=argparse.RawDescriptionHelpFormatter,
+        "campaign", parents=[c], add_help=False, formatter_class=_HelpFormatter,
         help="compare's grid as a resumable campaign: results written as tasks finish, retries, Dask clusters",
         description="Run compare's grid (scenarios x test OLCs x seeds x estimators x update intervals) task by "
                     "task on any scheduler, appending one JSON line per finished task to OUT/results.jsonl. Run the "
@@ -681,17 +790,26 @@ def build_parser() -> argparse.ArgumentParser:
 
     m = sub.add_parser("modes", help="modal frequencies and damping of the linearised model")
     m.add_argument("--case", default=None, help="OLC number (default: parked, still water)")
-    m.add_argument("--effects", default="all")
+    m.add_argument("--effects", default="all", help=effects_help)
     m.add_argument("--json", default=None, help="write the table as JSON")
     m.set_defaults(func=_cmd_modes)
     return p
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``fowt-env`` console script."""
-    args = build_parser().parse_args(argv)
+    """Entry point of the ``fowt-env`` console script.
+
+    Usage errors (unknown or misspelt options, bad values) exit with status 2 after the subcommand's usage.
+    """
+    parser = build_parser()
+    args, extra = parser.parse_known_args(argv)
+    command = parser.subcommands[args.command]
+    if extra:  # argparse would blame the top-level parser; the misspelt option belongs to the subcommand
+        command.error(f"unrecognized arguments: {' '.join(extra)}")
     try:
         return int(args.func(args))
+    except _UsageError as exc:
+        command.error(str(exc))
     except ValueError as exc:
         print(f"fowt-env {args.command}: error: {exc}", file=sys.stderr)
         return 2

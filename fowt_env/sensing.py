@@ -7,7 +7,8 @@ is trained either on the user's own complete records (``train=[...]``, e.g. a he
 turbine) or, by default, on the surrogate's training set of the comparison harness (the seed paper's OLCs,
 :class:`fowt_env.compare.CompareSettings`). The result carries the reconstructed record (every channel; live
 channels as the sensor returns them), the per-channel standard deviation for uncertainty-aware sensors, the mask
-and, if a noise-free truth is given, R² and NRMSE of every lost channel over the samples it was lost.
+and R² and NRMSE of every lost channel over the samples it was lost: against the noise-free truth if one is
+given, else, for the channels hidden on purpose (``hide``), against their measured values.
 """
 
 from __future__ import annotations
@@ -38,8 +39,10 @@ class SensingResult:
         True where the channel was live (measured, finite, not hidden).
     estimator : str
     scores : dict
-        Per lost channel: ``lost_fraction`` and, with a truth, ``r2`` and ``nrmse`` over the samples it was lost
-        (normalised by the variance and range of the whole truth record).
+        Per lost channel: ``lost_fraction`` and ``r2`` and ``nrmse`` over the samples it was lost (normalised by
+        the variance and range of the whole reference record), None without a reference; ``reference`` says
+        which: ``"truth"`` (the given noise-free truth) or ``"measured"`` (a channel hidden on purpose, scored
+        against its own measured values).
     timing : dict
         ``fit_s``, ``reconstruct_s``, ``us_per_sample`` (wall clock).
     measured : ndarray (n_samples, n_channels) or None
@@ -64,7 +67,8 @@ class SensingResult:
         for name, s in self.scores.items():
             r2 = "-" if s.get("r2") is None else f"{s['r2']:.4f}"
             nr = "-" if s.get("nrmse") is None else f"{100 * s['nrmse']:.2f}"
-            lines.append(f"{name:<12}{units[name]:>8}{100 * s['lost_fraction']:>9.1f}{r2:>10}{nr:>10}")
+            lines.append(f"{name:<12}{units[name]:>8}{100 * s['lost_fraction']:>9.1f}{r2:>10}{nr:>10}"
+                         + ("  (vs the measured values)" if s.get("reference") == "measured" else ""))
         if not self.scores:
             lines.append("(no channel was lost)")
         lines.append(f"fit {self.timing.get('fit_s', 0.0):.1f} s, reconstruction "
@@ -271,9 +275,15 @@ def sense(
         lost = ~mask[:, j]
         if not lost.any():
             continue
-        s: dict[str, float | None] = {"lost_fraction": float(lost.mean()), "r2": None, "nrmse": None}
+        s: dict[str, Any] = {"lost_fraction": float(lost.mean()), "r2": None, "nrmse": None}
         if tr is not None:  # over the lost samples, normalised by the whole truth record (as compare scores)
             s["r2"], s["nrmse"] = _hidden_scores(tr[:, j], est[:, j], lost)
+            s["reference"] = "truth"
+        elif n in hide:  # hidden on purpose: the measured values are the reference, where the record has them
+            known = np.isfinite(y[:, j])
+            if (lost & known).any():
+                s["r2"], s["nrmse"] = _hidden_scores(y[known, j], est[known, j], lost[known])
+                s["reference"] = "measured"
         scores[n] = s
     return SensingResult(rec, std_rec, mask, estimator, scores,
                          {"fit_s": fit_s, "reconstruct_s": wall, "us_per_sample": 1e6 * wall / max(len(y), 1)},

@@ -76,3 +76,12 @@ def test_the_sense_command(records, tmp_path, capsys):
     assert main(["sense", str(paths[0]), "--hide", "Nope", "--train", str(paths[2]), "--out",
                  str(tmp_path / "x.npz")]) == 2
     assert "not among the sensed channels" in capsys.readouterr().err
+
+
+def test_channels_hidden_on_purpose_are_scored_against_their_measured_values(records):
+    """Without a truth record, sense still has the values it hid itself: R² and NRMSE against them (issue 19)."""
+    noisy, _, train = records
+    res = sense(noisy, "hold", hide=["TwHt1ALxt"], train=train)
+    s = res.scores["TwHt1ALxt"]
+    assert s["reference"] == "measured" and s["r2"] is not None and s["nrmse"] > 0
+    assert "vs the measured values" in res.summary()
