@@ -1,22 +1,19 @@
-"""Quasi-steady rotor aerodynamics of the NREL 5 MW and its baseline pitch/torque controller.
+"""Quasi-steady rotor aerodynamics of the NREL 5 MW and its operating point under the OC3 Hywind controller.
 
 The rotor is described by its steady power, thrust and torque coefficient surfaces ``Cp, Ct, Cq(lambda,
 beta)`` (NREL's ROSCO table ``Cp_Ct_Cq.NREL5MW.txt``, computed with CCBlade from the NREL 5 MW blade; shipped
-in ``surrogates/data`` under Apache-2.0). For a load case the operating point (rotor speed, blade pitch,
-thrust, torque) is solved from the table and the controller's design rules, and thrust and torque are
-linearised about it:
+in ``surrogates/data`` under Apache-2.0). The simulation evaluates them at every step with the wind relative
+to the moving hub (the ``rotor_nonlinear`` effect, with the controller of :mod:`surrogates.controller`). For
+the linear model (``linearize()``, modal analysis, ``rotor_nonlinear=0``) thrust and torque are linearised
+about the steady operating point that the same controller reaches at the mean wind:
 
     dT = T_V (V - v_hub) + T_Omega dOmega + T_beta dbeta
     dQ = Q_V (V - v_hub) + Q_Omega dOmega + Q_beta dbeta
 
-with ``v_hub`` the fore-aft velocity of the hub (the ``aero_damping`` effect). The baseline controller is
-the one Jonkman (2010) used for OC3 Hywind: constant generator torque above rated and the NREL 5 MW
-gain-scheduled PI collective-pitch loop on rotor speed, with its natural frequency lowered well below the
-platform pitch frequency so that the platform pitch mode is not destabilised (Jonkman used 0.2 rad/s; this
-surrogate uses 0.1 rad/s, see ``RATED``). The gains follow the
-published design rule (Jonkman et al. 2009, section 7.4: dP/dbeta = -25.52 MW/rad at rated, gain-correction
-factor 1 / (1 + beta / 6.302336 deg)). Below rated the generator torque follows the optimal-tip-speed law and
-the pitch stays at fine pitch.
+with ``v_hub`` the hub velocity along the shaft (the ``aero_damping`` effect), and the controller is linearised
+too: the generator-torque law's slope about the operating point (zero in region 3: constant torque) and the
+gain-scheduled PI pitch loop of ``DISCON_OC3Hywind`` on rotor speed (``GK N PC_KP``, ``GK N PC_KI``; the
+generator-speed filter, the saturations and the rate limits are what the linearisation leaves out).
 """
 
 from __future__ import annotations
@@ -25,8 +22,8 @@ from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
 
+import numba
 import numpy as np
-from scipy.interpolate import RegularGridInterpolator
 from scipy.optimize import brentq
 
 from .oc3 import RHO_AIR
@@ -39,16 +36,10 @@ RATED = {
     "rotor_speed_rpm": 12.1,  # rpm
     "wind_speed": 11.4,  # m/s
     "min_pitch_rad": 0.0,
-    # rad/s. Jonkman (2010, section 7.2) detuned the OC3 Hywind loop from 0.6 to 0.2 rad/s, just below the
-    # platform pitch frequency (0.21 rad/s). In this surrogate (no radiation damping) 0.2 rad/s still leaves a
-    # coupled pitch-controller mode with negative damping between 11.4 and 13 m/s, so the loop is placed at
-    # half the platform pitch frequency, the rule of Larsen & Hanson (2007); every mode is then damped.
-    "pitch_controller_frequency": 0.1,
-    "pitch_controller_damping": 0.7,  # -
     # gain scheduling of the NREL 5 MW baseline controller (Jonkman et al. 2009, section 7.4): sensitivity of
-    # aerodynamic power to pitch at rated, and the pitch angle at which it has doubled
+    # aerodynamic power to pitch at rated, and the pitch angle at which it has doubled (DISCON's PC_KK)
     "dP_dpitch_rated": -25.52e6,  # W/rad
-    "pitch_doubling_rad": float(np.deg2rad(6.302336)),
+    "pitch_doubling_rad": 0.1099965,
 }
 
 
@@ -75,32 +66,41 @@ class RotorTable:
     cq: np.ndarray
     radius: float
 
-    def _interp(self, name: str):
-        return RegularGridInterpolator((self.tsr, self.pitch_rad), getattr(self, name), method="cubic")
-
     def coefficients(self, tsr: float, pitch_rad: float) -> tuple[float, float]:
-        """Power and thrust coefficients at one point (cubic interpolation)."""
-        pt = np.array([[tsr, pitch_rad]])
-        return float(_interp_cache(self, "cp")(pt)[0]), float(_interp_cache(self, "ct")(pt)[0])
+        """Power and thrust coefficients at one point (bilinear, clamped to the table's edges)."""
+        ct, cq = rotor_coefficients(self.tsr, self.pitch_rad, self.ct, self.cq, float(tsr), float(pitch_rad))
+        return cq * float(tsr), ct
 
     def loads(self, wind: float, omega: float, pitch_rad: float) -> tuple[float, float]:
         """Aerodynamic thrust (N) and torque (N·m) for wind (m/s), rotor speed (rad/s) and pitch (rad)."""
-        lam = omega * self.radius / max(wind, 1e-6)
-        cp, ct = self.coefficients(lam, pitch_rad)
-        area = np.pi * self.radius**2
-        thrust = 0.5 * RHO_AIR * area * wind**2 * ct
-        torque = 0.5 * RHO_AIR * area * wind**3 * cp / max(omega, 1e-6)
-        return thrust, torque
+        v = max(wind, 1e-6)
+        lam = omega * self.radius / v
+        ct, cq = rotor_coefficients(self.tsr, self.pitch_rad, self.ct, self.cq, lam, float(pitch_rad))
+        q = 0.5 * RHO_AIR * np.pi * self.radius**2 * v * v
+        return q * ct, q * self.radius * cq
 
 
-_INTERPS: dict[tuple[int, str], RegularGridInterpolator] = {}
-
-
-def _interp_cache(table: RotorTable, name: str) -> RegularGridInterpolator:
-    key = (id(table), name)
-    if key not in _INTERPS:
-        _INTERPS[key] = table._interp(name)
-    return _INTERPS[key]
+@numba.njit(cache=True, nogil=True)
+def rotor_coefficients(tsr, pitch, ct, cq, lam, beta):
+    """Thrust and torque coefficients ``(Ct, Cq)`` at tip-speed ratio ``lam`` and pitch ``beta`` (rad) by
+    bilinear interpolation on the table's uniform grid, clamped at its edges. Used by the simulation kernel
+    and by the operating-point solver alike, so both see the same rotor."""
+    nl, nb = tsr.shape[0], pitch.shape[0]
+    fl = (lam - tsr[0]) / (tsr[1] - tsr[0])
+    fb = (beta - pitch[0]) / (pitch[1] - pitch[0])
+    fl = min(max(fl, 0.0), nl - 1.000001)
+    fb = min(max(fb, 0.0), nb - 1.000001)
+    i = int(fl)
+    j = int(fb)
+    wl = fl - i
+    wb = fb - j
+    c00 = (1 - wl) * (1 - wb)
+    c10 = wl * (1 - wb)
+    c01 = (1 - wl) * wb
+    c11 = wl * wb
+    t = c00 * ct[i, j] + c10 * ct[i + 1, j] + c01 * ct[i, j + 1] + c11 * ct[i + 1, j + 1]
+    q = c00 * cq[i, j] + c10 * cq[i + 1, j] + c01 * cq[i, j + 1] + c11 * cq[i + 1, j + 1]
+    return t, q
 
 
 def _read_block(lines: list[str], start: int, n_rows: int) -> np.ndarray:
@@ -208,29 +208,27 @@ def operating_point(
     """
     if not np.isfinite(wind_speed) or wind_speed <= 0:
         raise ValueError(f"wind_speed must be a positive finite number (m/s), got {wind_speed!r}")
+    from .controller import DISCON, generator_torque_law, steady_state
+
     table = rotor_table()
-    rated_aero_power = RATED["electrical_power"] / RATED["generator_efficiency"]
-    omega_rated = RATED["rotor_speed_rpm"] * np.pi / 30.0
-    fine = RATED["min_pitch_rad"]
-    # optimal tip-speed ratio at fine pitch
-    lam_grid = np.linspace(table.tsr[0], table.tsr[-1], 400)
-    cp_fine = [table.coefficients(lam, fine)[0] for lam in lam_grid]
-    lam_opt = lam_grid[int(np.argmax(cp_fine))]
+    n_gear = 97.0
     if rotor_rpm is None:
-        omega = min(omega_rated, lam_opt * wind_speed / table.radius)
+        ss = steady_state(lambda v, w, b: table.loads(v, w, b)[1], wind_speed, n_gear)
+        omega, pitch = ss.rotor_speed, ss.pitch
+        above = ss.region == "3"
     else:
         if not np.isfinite(rotor_rpm) or rotor_rpm <= 0:
             raise ValueError(f"rotor_rpm must be a positive finite number (rpm), got {rotor_rpm!r}")
         omega = rotor_rpm * np.pi / 30.0
-    power_fine = table.loads(wind_speed, omega, fine)[1] * omega
-    above = power_fine > rated_aero_power and omega >= 0.999 * omega_rated
-    if above:
-        def excess(beta: float) -> float:
-            return table.loads(wind_speed, omega, beta)[1] * omega - rated_aero_power
-
-        pitch = brentq(excess, fine, np.deg2rad(25.0))
-    else:
-        pitch = fine
+        # the pitch that balances the torque law at this speed (fine pitch if the rotor cannot reach it)
+        q_gen = n_gear * generator_torque_law(n_gear * omega, 0.0)
+        above = bool(n_gear * omega >= DISCON["VS_RtGnSp"] * (1 - 1e-6)
+                     and table.loads(wind_speed, omega, 0.0)[1] > q_gen)
+        if above:
+            q_gen = n_gear * generator_torque_law(n_gear * omega, 1.0)
+            pitch = brentq(lambda b: table.loads(wind_speed, omega, b)[1] - q_gen, 0.0, np.deg2rad(45.0))
+        else:
+            pitch = 0.0
     thrust, torque = table.loads(wind_speed, omega, pitch)
 
     def d(fun_idx: int, dv: float, dw: float, db: float) -> float:
@@ -244,19 +242,17 @@ def operating_point(
         "dQ_dV": d(1, dv, 0, 0), "dQ_dOmega": d(1, 0, dw, 0), "dQ_dpitch": d(1, 0, 0, db),
     }
     if above:
-        # constant generator torque (OC3 Hywind); gain-scheduled PI pitch loop of the NREL 5 MW baseline
-        # controller: gains placed for (omega_n, zeta) with the *published* dP/dbeta at rated, scheduled by
-        # GK = 1 / (1 + beta / beta_K) (Jonkman et al. 2009, eqs. 7-? "gain-correction factor").
-        wn, zeta = RATED["pitch_controller_frequency"], RATED["pitch_controller_damping"]
-        dp_db0 = RATED["dP_dpitch_rated"]
-        gk = 1.0 / (1.0 + pitch / RATED["pitch_doubling_rad"])
-        kp = 2.0 * drivetrain_inertia * omega_rated * zeta * wn / (-dp_db0) * gk
-        ki = drivetrain_inertia * omega_rated * wn**2 / (-dp_db0) * gk
+        # DISCON_OC3Hywind: constant generator torque, PI pitch on the HSS speed error with GK = 1/(1+beta/KK)
+        gk = 1.0 / (1.0 + pitch / DISCON["PC_KK"])
+        kp = gk * DISCON["PC_KP"] * n_gear
+        ki = gk * DISCON["PC_KI"] * n_gear
         dqgen = 0.0
     else:
         kp = ki = 0.0
-        # optimal-mode torque law Q = k omega^2 (referred to the LSS) balances the aerodynamic torque
-        dqgen = 2.0 * torque / omega
+        # slope of the torque law (regions 1.5, 2, 2.5), referred to the LSS: N^2 dQ_hss/dw_hss
+        w_g, h = n_gear * omega, 1e-3
+        dqgen = n_gear**2 * (generator_torque_law(w_g + h) - generator_torque_law(w_g - h)) / (2 * h)
+    del drivetrain_inertia  # the gains are DISCON's, not placed for an inertia
     return OperatingPoint(
         wind_speed=float(wind_speed), rotor_speed=float(omega), pitch=float(pitch), thrust=float(thrust),
         aero_torque=float(torque), generator_torque_lss=float(torque), kp=float(kp), ki=float(ki),

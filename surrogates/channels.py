@@ -44,6 +44,8 @@ __all__ = [
     "tower_channels",
     "PLATFORM_CHANNELS",
     "ENVIRONMENT_CHANNELS",
+    "ROTOR_CHANNELS",
+    "TOWER_EXTRA_CHANNELS",
     "ALL_CHANNELS",
     "UNITS",
     "channel_index",
@@ -115,10 +117,20 @@ PLATFORM_CHANNELS: list[str] = ["PtfmSurge", "PtfmSway", "PtfmHeave", "PtfmRoll"
 ENVIRONMENT_CHANNELS: list[str] = ["RotSpeed", "Wave1Elev", "Wind1VelX"]
 """Rotor speed (rpm), wave elevation at the platform (m), hub-height longitudinal wind speed (m/s)."""
 
-ALL_CHANNELS: list[str] = tower_channels(None) + PLATFORM_CHANNELS + ENVIRONMENT_CHANNELS
-"""All 45 known channels, in the order: the 36 tower channels of ``tower_channels(None)`` (FA accelerations,
-SS accelerations, FA moments, SS moments, gauges 1-9 each), then :data:`PLATFORM_CHANNELS`, then
-:data:`ENVIRONMENT_CHANNELS`."""
+ROTOR_CHANNELS: list[str] = ["BldPitch1", "GenTq", "GenPwr", "RotThrust"]
+"""Blade pitch (deg), generator torque (kN-m, high-speed shaft), electrical power (kW), low-speed-shaft thrust
+(kN: aerodynamic thrust plus the rotor's weight and inertia along the shaft, ElastoDyn's ``RotThrust``)."""
+
+TOWER_EXTRA_CHANNELS: list[str] = ["TwrBsMxt", "TwrBsMyt", "YawBrTAxp", "YawBrTAyp", "TTDspFA", "TTDspSS"]
+"""Tower-base side-to-side / fore-aft bending moments at 10 m above SWL (kN-m), tower-top (yaw-bearing)
+fore-aft / side-to-side accelerations without gravity (m/s^2), tower-top fore-aft / side-to-side deflections
+relative to the undeflected tower (m), ElastoDyn's definitions."""
+
+ALL_CHANNELS: list[str] = (tower_channels(None) + PLATFORM_CHANNELS + ENVIRONMENT_CHANNELS + ROTOR_CHANNELS
+                           + TOWER_EXTRA_CHANNELS)
+"""All 55 known channels, in the order: the 36 tower channels of ``tower_channels(None)`` (FA accelerations,
+SS accelerations, FA moments, SS moments, gauges 1-9 each), then :data:`PLATFORM_CHANNELS`,
+:data:`ENVIRONMENT_CHANNELS`, :data:`ROTOR_CHANNELS` and :data:`TOWER_EXTRA_CHANNELS`."""
 
 UNITS: dict[str, str] = {
     **{name: "m/s^2" for name in _gauge_names("ALxt") + _gauge_names("ALyt")},
@@ -132,6 +144,16 @@ UNITS: dict[str, str] = {
     "RotSpeed": "rpm",
     "Wave1Elev": "m",
     "Wind1VelX": "m/s",
+    "BldPitch1": "deg",
+    "GenTq": "kN-m",
+    "GenPwr": "kW",
+    "RotThrust": "kN",
+    "TwrBsMxt": "kN-m",
+    "TwrBsMyt": "kN-m",
+    "YawBrTAxp": "m/s^2",
+    "YawBrTAyp": "m/s^2",
+    "TTDspFA": "m",
+    "TTDspSS": "m",
 }
 """OpenFAST unit string of every channel in :data:`ALL_CHANNELS`."""
 

@@ -1,7 +1,10 @@
 """Named, switchable physical effects: the vocabulary of the discrepancy workflow.
 
 Each effect has a strength: 1.0 is nominal, 0.0 switches it off, other values scale it (e.g. 1.5 = 50 %
-stronger drag). ``FOWTModel(effects="none")`` is the linear structural-hydro-aero model without any of them.
+stronger drag). ``FOWTModel(effects="none")`` is the linear turbine: the linearisation of the full model about its
+operating point. It switches off every effect that a linearisation cannot hold (``linear=False``) and keeps the
+linear ones (aerodynamic damping, gyroscopics, P-delta) on, as every linear model of this turbine (OpenFAST's
+included) has them; they can still be switched off by name.
 """
 
 from __future__ import annotations
@@ -47,6 +50,15 @@ EFFECTS: dict[str, Effect] = {
                "at 3P and 6P.", linear=False),
         Effect("rotor_1p", "Rotor mass and aerodynamic imbalance: a rotating in-plane force and 1P thrust and "
                "moment variations.", linear=False),
+        Effect("rotor_nonlinear", "Thrust and torque from the Cp/Ct/Cq(lambda, beta) surfaces at every step with the "
+               "rotor-effective wind relative to the moving hub, under the OC3 Hywind DISCON controller (torque-law "
+               "regions, gain-scheduled PI pitch, saturation and rate limits); off = rotor and controller "
+               "linearised about the operating point. Any strength > 0 switches it on.", linear=False),
+        Effect("rotor_asymmetry", "Rotor yaw and tilt moments and side force from the gradients of the turbulent "
+               "wind over the disc (and the mean shear): what drives roll, yaw and the side-to-side tower response.",
+               linear=True),
+        Effect("tower_drag", "Aerodynamic drag of the tower (Cd = 1.0 under the power-law wind profile), "
+               "quadratic in the hub-height wind.", linear=False),
         Effect("p_delta", "Gravity geometric softening: the weight of tower and RNA acting through the lateral "
                "displacements of tilt and bending (P-delta).", linear=True),
     )
@@ -59,8 +71,8 @@ def resolve_effects(effects: str | Mapping[str, float] | None) -> dict[str, floa
     Parameters
     ----------
     effects : {"all", "none"} or mapping or None
-        ``"all"``/None: every effect at 1.0; ``"none"``: all 0.0; a mapping sets the named strengths and leaves
-        the others at 1.0.
+        ``"all"``/None: every effect at 1.0; ``"none"``: the nonlinear effects at 0.0 and the linear ones at 1.0
+        (the linearisation of the full model); a mapping sets the named strengths and leaves the others at 1.0.
 
     Returns
     -------
@@ -76,7 +88,7 @@ def resolve_effects(effects: str | Mapping[str, float] | None) -> dict[str, floa
         return {name: 1.0 for name in EFFECTS}
     if isinstance(effects, str):
         if effects == "none":
-            return {name: 0.0 for name in EFFECTS}
+            return {name: (1.0 if e.linear else 0.0) for name, e in EFFECTS.items()}
         raise ValueError(f"effects must be 'all', 'none' or a mapping of effect strengths, got {effects!r}")
     out = {name: 1.0 for name in EFFECTS}
     for name, value in dict(effects).items():

@@ -11,13 +11,19 @@ const      1      1.0: carries the mean loads (gravity offsets, mean thrust, gen
 wave       6      first-order wave excitation about the SWL reference point (N, N·m)
 wind       1      rotor-effective wind deviation from the mean (m/s)
 elev       1      wave elevation at the origin (m; passed to ``Wave1Elev`` only)
-hub_wind   1      hub-height point wind (m/s; passed to ``Wind1VelX`` only)
+hub_wind   1      hub-height point wind (m/s; passed to ``Wind1VelX``, and the tower's aerodynamic drag)
+shear      2      linear gradients of the streamwise wind over the rotor disc, ``dU/dy`` and ``dU/dz`` (1/s):
+                  the rotor's yaw and tilt moments and side force (the ``rotor_asymmetry`` effect)
 action     2      collective blade-pitch offset (rad), generator-torque offset (N·m, low-speed shaft)
 hub        6      rotor harmonic loads at the hub, global axes (N, N·m): the 1P/3P/6P effects
 nonlinear  10     generalised forces of the nonlinear effects (drag, catenary mooring)
+rotor      5      quantities evaluated per step: blade pitch (rad), generator torque (N·m, HSS), electrical
+                  power (W), aerodynamic thrust (N) of the nonlinear rotor (``rotor_nonlinear``; they reach the
+                  outputs only, their loads enter through ``hub``), and ``V|V|`` of the hub-height wind
+                  (m²/s², the ``tower_drag`` effect's load)
 =========  =====  ===========================================================================
 
-Outputs are the 45 channels of :data:`surrogates.channels.ALL_CHANNELS` in OpenFAST units. Linear effects
+Outputs are the 55 channels of :data:`surrogates.channels.ALL_CHANNELS` in OpenFAST units. Linear effects
 (``aero_damping``, ``gyroscopic``, ``p_delta``) live in ``A``; nonlinear ones are evaluated per step by the
 simulator and enter through the ``hub`` and ``nonlinear`` input blocks.
 """
@@ -34,6 +40,7 @@ from scipy.optimize import linear_sum_assignment
 
 from .aero import OperatingPoint, operating_point
 from .channels import ALL_CHANNELS, GAUGE_HEIGHTS, UNITS, tower_channels
+from .controller import DISCON
 from .effects import resolve_effects
 from .load_cases import LoadCase, load_case
 from .oc3 import GRAVITY
@@ -51,15 +58,19 @@ INPUT_BLOCKS: dict[str, slice] = {
     "wind": slice(7, 8),
     "elev": slice(8, 9),
     "hub_wind": slice(9, 10),
-    "action": slice(10, 12),
-    "hub": slice(12, 18),
-    "nonlinear": slice(18, 28),
+    "shear": slice(10, 12),
+    "action": slice(12, 14),
+    "hub": slice(14, 20),
+    "nonlinear": slice(20, 30),
+    "rotor": slice(30, 35),
 }
-N_INPUT = 28
+N_INPUT = 35
 INPUT_NAMES: tuple[str, ...] = (
     ("const", "wave_Fx", "wave_Fy", "wave_Fz", "wave_Mx", "wave_My", "wave_Mz", "wind_dev", "wave_elevation",
-     "hub_wind", "pitch_offset", "torque_offset", "hub_Fx", "hub_Fy", "hub_Fz", "hub_Mx", "hub_My", "hub_Mz")
+     "hub_wind", "shear_y", "shear_z", "pitch_offset", "torque_offset", "hub_Fx", "hub_Fy", "hub_Fz", "hub_Mx",
+     "hub_My", "hub_Mz")
     + tuple(f"nl_{d}" for d in DOF_LABELS)
+    + ("rotor_pitch", "rotor_generator_torque", "rotor_power", "rotor_thrust", "hub_wind_squared")
 )
 assert len(INPUT_NAMES) == N_INPUT and len(STATE_NAMES) == 22
 
@@ -239,8 +250,14 @@ class FOWTModel:
     noise : SensorNoise, optional
         Sensor noise added by :func:`surrogates.simulate`.
     accel_gravity : bool
-        If True (default) the tower accelerations include the projection of gravity on the tilted sensor
-        axis, as an accelerometer measures it (``ALxt = a_x - g * tilt``).
+        If False (default) the tower accelerations are OpenFAST's ``TwHt*ALxt/ALyt``: translational
+        accelerations without gravity. If True they include the projection of gravity on the tilted sensor
+        axis, as a physical accelerometer measures it (``ALxt = a_x - g * tilt``); such a record no longer
+        follows OpenFAST's definition of those channels.
+    gauge_heights : sequence of 9 floats, optional
+        Heights of the tower gauges above still water (m), gauge 1 first. Default
+        :data:`surrogates.channels.GAUGE_HEIGHTS` (10 ... 87.6 m, equally spaced); OpenFAST's OC3 deck with
+        ``TwrGagNd = 1, 3, 6, 8, 10, 13, 15, 18, 20`` has them at :data:`OPENFAST_GAUGE_HEIGHTS`.
 
     Examples
     --------
@@ -258,9 +275,16 @@ class FOWTModel:
         *,
         harmonics: RotorHarmonics | None = None,
         noise: SensorNoise | None = None,
-        accel_gravity: bool = True,
+        accel_gravity: bool = False,
+        gauge_heights=None,
     ) -> None:
         self._effects = resolve_effects(effects)
+        heights = GAUGE_HEIGHTS if gauge_heights is None else np.asarray(gauge_heights, dtype=float)
+        if heights.shape != (len(GAUGE_HEIGHTS),) or not np.all(np.isfinite(heights)):
+            raise ValueError(f"gauge_heights must be {len(GAUGE_HEIGHTS)} finite heights (m), got {gauge_heights!r}")
+        if np.any(heights < 10.0 - 1e-9) or np.any(heights > 87.6 + 1e-9):
+            raise ValueError(f"gauge_heights must lie on the tower, 10 to 87.6 m above SWL, got {heights.tolist()}")
+        self.gauge_heights = tuple(float(h) for h in heights)
         self.harmonics = harmonics if harmonics is not None else RotorHarmonics()
         self.noise = noise if noise is not None else SensorNoise()
         self.accel_gravity = bool(accel_gravity)
@@ -269,7 +293,7 @@ class FOWTModel:
             if not np.isfinite(v) or v < 0:
                 raise ValueError(f"harmonics.{f} must be finite and >= 0, got {v!r}")
         self.noise.std([])  # validates
-        self._systems: dict[LoadCase | None, LinearSystem] = {}
+        self._systems: dict[tuple[LoadCase | None, bool], LinearSystem] = {}
 
     # ------------------------------------------------------------------------------------------- effects
     @property
@@ -281,7 +305,8 @@ class FOWTModel:
         """New model with some effect strengths changed, e.g. ``m.with_effects(quadratic_drag=1.5)``."""
         checked = resolve_effects(strengths)  # validates names and values
         eff = {**self._effects, **{k: checked[k] for k in strengths}}
-        return FOWTModel(eff, harmonics=self.harmonics, noise=self.noise, accel_gravity=self.accel_gravity)
+        return FOWTModel(eff, harmonics=self.harmonics, noise=self.noise, accel_gravity=self.accel_gravity,
+                         gauge_heights=self.gauge_heights)
 
     def without(self, *names: str) -> FOWTModel:
         """New model with the named effects switched off."""
@@ -290,7 +315,8 @@ class FOWTModel:
     def with_noise(self, noise: SensorNoise | None = None, **changes: float) -> FOWTModel:
         """New model with another sensor-noise specification (``scale=0`` for noise-free records)."""
         new_noise = replace(noise if noise is not None else self.noise, **changes)
-        return FOWTModel(self._effects, harmonics=self.harmonics, noise=new_noise, accel_gravity=self.accel_gravity)
+        return FOWTModel(self._effects, harmonics=self.harmonics, noise=new_noise, accel_gravity=self.accel_gravity,
+                         gauge_heights=self.gauge_heights)
 
     def __repr__(self) -> str:
         on = [f"{k}={v:g}" for k, v in self._effects.items() if v != 0.0]
@@ -303,13 +329,15 @@ class FOWTModel:
             "harmonics": {f: getattr(self.harmonics, f) for f in self.harmonics.__dataclass_fields__},
             "noise": {f: getattr(self.noise, f) for f in self.noise.__dataclass_fields__},
             "accel_gravity": self.accel_gravity,
+            "gauge_heights": list(self.gauge_heights),
         }
 
     @classmethod
     def from_dict(cls, d: Mapping) -> FOWTModel:
         """Inverse of :meth:`to_dict`."""
         return cls(d.get("effects", "all"), harmonics=RotorHarmonics(**d.get("harmonics", {})),
-                   noise=SensorNoise(**d.get("noise", {})), accel_gravity=d.get("accel_gravity", True))
+                   noise=SensorNoise(**d.get("noise", {})), accel_gravity=d.get("accel_gravity", False),
+                   gauge_heights=d.get("gauge_heights"))
 
     @cached_property
     def structure(self) -> Structure:
@@ -325,18 +353,26 @@ class FOWTModel:
         case : int or LoadCase or None
             Load case; None means parked (no wind, rotor locked, still water).
         """
-        lc = _as_case(case)
-        if lc not in self._systems:
-            self._systems[lc] = self._assemble(lc)
-        return self._systems[lc]
+        return self._system(case, nonlinear_rotor=False)
 
-    def _assemble(self, lc: LoadCase | None) -> LinearSystem:  # noqa: C901 - one linear-algebra recipe
+    def _system(self, case: int | LoadCase | None, nonlinear_rotor: bool) -> LinearSystem:
+        """The linear system, or (``nonlinear_rotor``) its structural part for the simulation's nonlinear rotor:
+        no linearised aerodynamic or controller terms, the rotor speed and thrust evaluated per step instead."""
+        lc = _as_case(case)
+        operating = lc is not None and lc.wind_speed > 0 and lc.rotor_rpm > 0
+        key = (lc, bool(nonlinear_rotor and operating))
+        if key not in self._systems:
+            self._systems[key] = self._assemble(lc, key[1])
+        return self._systems[key]
+
+    def _assemble(self, lc: LoadCase | None, nonlinear_rotor: bool = False) -> LinearSystem:  # noqa: C901
         st = self.structure
         eff = self._effects
         s_aero, s_gyro, s_pd = eff["aero_damping"], eff["gyroscopic"], eff["p_delta"]
         operating = lc is not None and lc.wind_speed > 0 and lc.rotor_rpm > 0
         op = operating_point(lc.wind_speed, lc.rotor_rpm, st.rotor_inertia_lss) if operating else None
         omega0 = op.rotor_speed if op is not None else 0.0
+        linear_rotor = op is not None and not nonlinear_rotor
 
         m = st.mass
         k = st.stiffness + s_pd * st.stiffness_pdelta
@@ -353,7 +389,7 @@ class FOWTModel:
         qg_x, qg_u = np.zeros(n_x), np.zeros(n_u)  # generator torque deviation
         t0 = qg0 = 0.0
         iw, ia = INPUT_BLOCKS["wind"].start, INPUT_BLOCKS["action"].start
-        if op is not None:
+        if linear_rotor:
             t0, qg0 = op.thrust, op.generator_torque_lss
             pitch_x = np.zeros(n_x)
             pitch_x[2 * N_DOF] = op.kp
@@ -379,6 +415,16 @@ class FOWTModel:
         f_u[:, hub.start:hub.start + 3] += j_hub.T
         f_u[:, hub.start + 3:hub.stop] += r_tt.T
         f_u[:, INPUT_BLOCKS["nonlinear"]] += np.eye(N_DOF)
+        # rotor asymmetry: hub loads per unit disc gradient of the wind, (force, moment) per column
+        shear_loads = _shear_hub_loads(op, st.data.tip_radius, eff["rotor_asymmetry"])
+        sh = INPUT_BLOCKS["shear"]
+        for col, (force, moment) in zip(range(sh.start, sh.stop), shear_loads, strict=True):
+            f_u[:, col] += j_hub.T @ force + r_tt.T @ moment
+        # tower drag: generalised force per unit V|V| of the hub wind
+        itd = INPUT_BLOCKS["rotor"].start + 4
+        twr_z, twr_f = _tower_drag_strips(st.data.tower_base_height, st.data.tower_top_height, eff["tower_drag"])
+        for z_s, f_s in zip(twr_z, twr_f, strict=True):
+            f_u[:, itd] += f_s * st.point_translation(z_s)[0]
         if op is not None and s_gyro:
             h0 = st.spin_inertia * omega0
             gyro = s_gyro * h0 * r_tt.T @ _skew(e_s) @ r_tt
@@ -392,13 +438,13 @@ class FOWTModel:
         a[N_DOF:2 * N_DOF, N_DOF:2 * N_DOF] = -minv @ c
         a[N_DOF:2 * N_DOF] += minv @ f_x
         b[N_DOF:2 * N_DOF] = minv @ f_u
-        if op is not None:
+        if linear_rotor:
             j = st.rotor_inertia_lss
             a[2 * N_DOF] = (qa_x - qg_x) / j
             b[2 * N_DOF] = (qa_u - qg_u) / j
             a[2 * N_DOF + 1, 2 * N_DOF] = 1.0
 
-        # ------------------------------------------------------------------ outputs (45 channels)
+        # ------------------------------------------------------------------ outputs (55 channels)
         qdd_x, qdd_u = a[N_DOF:2 * N_DOF], b[N_DOF:2 * N_DOF]
         thrust_x, thrust_u = t_x, t_u.copy()
         thrust_u[0] += t0
@@ -407,15 +453,24 @@ class FOWTModel:
         g_acc = GRAVITY if self.accel_gravity else 0.0
         p_hub = st.hub_position
         ez = np.array([0.0, 0.0, 1.0])
-        for gi, h in enumerate(GAUGE_HEIGHTS, start=1):
+        t_ref = op.thrust if op is not None else 0.0  # thrust of the geometric (deflection) moment term
+        z_top = st.data.tower_top_height
+        points = [(f"TwHt{gi}", h) for gi, h in enumerate(self.gauge_heights, start=1)]
+        points += [("TwrBs", st.data.tower_base_height), ("YawBr", z_top)]
+        for prefix, h in points:
             t_h = st.point_translation(h)
             r_h = st.point_rotation(h)
             ax_x = t_h[0] @ qdd_x
             ax_x[:N_DOF] -= g_acc * r_h[1]
             ay_x = t_h[1] @ qdd_x
             ay_x[:N_DOF] += g_acc * r_h[0]
-            rows_x[f"TwHt{gi}ALxt"], rows_u[f"TwHt{gi}ALxt"] = ax_x, t_h[0] @ qdd_u
-            rows_x[f"TwHt{gi}ALyt"], rows_u[f"TwHt{gi}ALyt"] = ay_x, t_h[1] @ qdd_u
+            if prefix == "YawBr":  # ElastoDyn's YawBrTAxp/yp: without gravity whatever accel_gravity says
+                rows_x["YawBrTAxp"], rows_u["YawBrTAxp"] = t_h[0] @ qdd_x, t_h[0] @ qdd_u
+                rows_x["YawBrTAyp"], rows_u["YawBrTAyp"] = t_h[1] @ qdd_x, t_h[1] @ qdd_u
+                continue
+            if prefix.startswith("TwHt"):
+                rows_x[f"{prefix}ALxt"], rows_u[f"{prefix}ALxt"] = ax_x, t_h[0] @ qdd_u
+                rows_x[f"{prefix}ALyt"], rows_u[f"{prefix}ALyt"] = ay_x, t_h[1] @ qdd_u
             # bending moment vector (N m) about the gauge from everything above it
             mom_x = np.zeros((3, n_x))
             mom_u = np.zeros((3, n_u))
@@ -432,14 +487,26 @@ class FOWTModel:
             lever_hub = _skew(p_hub - p_h)
             mom_x += np.outer(lever_hub @ e_s, thrust_x)
             mom_u += np.outer(lever_hub @ e_s, thrust_u)
-            mom_x[:, :N_DOF] += -_skew(e_s * t0) @ (st.hub_translation - t_h)
+            mom_x[:, :N_DOF] += -_skew(e_s * t_ref) @ (st.hub_translation - t_h)
             mom_u[:, hub.start:hub.start + 3] += lever_hub
             mom_u[:, hub.start + 3:hub.stop] += np.eye(3)
+            for col, (force, moment) in zip(range(sh.start, sh.stop), shear_loads, strict=True):
+                mom_u[:, col] += lever_hub @ force + moment
+            for z_s, f_s in zip(twr_z, twr_f, strict=True):
+                if z_s > h:
+                    mom_u[1, itd] += (z_s - h) * f_s
             mom_x += np.outer(e_s, qg_x)
             mom_u += np.outer(e_s, qg_u)
             mom_u[:, 0] += e_s * qg0
-            rows_x[f"TwHt{gi}MLyt"], rows_u[f"TwHt{gi}MLyt"] = mom_x[1] / 1e3, mom_u[1] / 1e3
-            rows_x[f"TwHt{gi}MLxt"], rows_u[f"TwHt{gi}MLxt"] = mom_x[0] / 1e3, mom_u[0] / 1e3
+            suffix = ("MLyt", "MLxt") if prefix.startswith("TwHt") else ("Myt", "Mxt")
+            rows_x[prefix + suffix[0]], rows_u[prefix + suffix[0]] = mom_x[1] / 1e3, mom_u[1] / 1e3
+            rows_x[prefix + suffix[1]], rows_u[prefix + suffix[1]] = mom_x[0] / 1e3, mom_u[0] / 1e3
+        # tower-top deflection relative to the undeflected tower (tower modes only)
+        t_top = st.point_translation(z_top)
+        for name, axis in (("TTDspFA", 0), ("TTDspSS", 1)):
+            rx = np.zeros(n_x)
+            rx[6:N_DOF] = t_top[axis, 6:N_DOF]
+            rows_x[name], rows_u[name] = rx, np.zeros(n_u)
         for i, name in enumerate(("PtfmSurge", "PtfmSway", "PtfmHeave", "PtfmRoll", "PtfmPitch", "PtfmYaw")):
             rx = np.zeros(n_x)
             rx[i] = 1.0 if i < 3 else np.rad2deg(1.0)
@@ -453,6 +520,37 @@ class FOWTModel:
             ru = np.zeros(n_u)
             ru[idx] = 1.0
             rows_x[name], rows_u[name] = np.zeros(n_x), ru
+        # rotor channels: linear expressions about the operating point, or the per-step values (rotor block)
+        n_gear = st.data.gearbox_ratio
+        eff_gen = DISCON["GenEff"]
+        ir = INPUT_BLOCKS["rotor"].start
+        pitch_x, pitch_u = np.zeros(n_x), np.zeros(n_u)
+        gen_x, gen_u = qg_x / n_gear, qg_u / n_gear
+        gen_u = gen_u.copy()
+        gen_u[0] += qg0 / n_gear
+        pow_x = eff_gen * (omega0 * qg_x)
+        pow_u = eff_gen * (omega0 * qg_u)
+        pow_x[2 * N_DOF] += eff_gen * qg0
+        pow_u[0] += eff_gen * omega0 * qg0
+        if linear_rotor:
+            pitch_x[2 * N_DOF], pitch_x[2 * N_DOF + 1] = op.kp, op.ki
+            pitch_u[0], pitch_u[ia] = op.pitch, 1.0
+        pitch_u[ir] += 1.0
+        gen_u[ir + 1] += 1.0
+        pow_u[ir + 2] += 1.0
+        rot_x, rot_u = thrust_x.copy(), thrust_u.copy()
+        rot_u[ir + 3] += 1.0
+        if op is not None:  # ElastoDyn's RotThrust: + rotor weight and inertia along the tilted shaft
+            m_rot = st.data.rotor_mass
+            tilt = st.data.shaft_tilt_rad
+            rot_u[0] += -m_rot * GRAVITY * np.sin(tilt)  # tilt < 0: the weight pushes down the shaft
+            rot_x[:N_DOF] += m_rot * GRAVITY * np.cos(tilt) * st.tower_top_rotation[1]
+            rot_x -= m_rot * h_v @ qdd_x
+            rot_u -= m_rot * h_v @ qdd_u
+        rows_x["BldPitch1"], rows_u["BldPitch1"] = np.rad2deg(pitch_x), np.rad2deg(pitch_u)
+        rows_x["GenTq"], rows_u["GenTq"] = gen_x / 1e3, gen_u / 1e3
+        rows_x["GenPwr"], rows_u["GenPwr"] = pow_x / 1e3, pow_u / 1e3
+        rows_x["RotThrust"], rows_u["RotThrust"] = rot_x / 1e3, rot_u / 1e3
         cmat = np.array([rows_x[ch] for ch in ALL_CHANNELS])
         dmat = np.array([rows_u[ch] for ch in ALL_CHANNELS])
         return LinearSystem(a, b, cmat, dmat, tuple(ALL_CHANNELS), op, omega0, dict(eff), st)
@@ -544,6 +642,45 @@ class FOWTModel:
     def units(channels: list[str]) -> list[str]:
         """OpenFAST units of channels."""
         return [UNITS[c] for c in channels]
+
+
+ROTOR_ASYMMETRY = {"moment": 0.17, "side_force": 0.45}
+"""Gains of the rotor's response to a linear wind gradient over the disc (-), calibrated against OpenFAST's OC3
+Hywind runs at 8, 12 and 18 m/s (tower-top yaw/tilt moments and the rotor side force regressed on the disc-fit
+gradients of the TurbSim inflow): tilt moment ``= moment * dT/dU * R^2 * dU/dz`` and yaw moment
+``= -moment * dT/dU * R^2 * dU/dy`` (blade-element scaling: the local thrust slope times the lever squared; the
+coefficient is the same within 10 % at all three speeds), side force ``= -side_force * dQ/dU * dU/dz`` (the
+in-plane forces of the upper and lower blades no longer cancel; within 15 % at 8 and 12 m/s, 30 % low at 18)."""
+
+TOWER_AERO = {"cd": 1.0, "diameter_base": 6.5, "diameter_top": 3.87, "shear_exponent": 0.2, "hub_height": 90.0}
+"""Tower aerodynamic drag of the OC3 deck (AeroDyn ``TwrAero = True``: Cd = 1.0, diameter 6.5 m at the base to
+3.87 m at the top) under the power-law mean profile (exponent 0.2, TurbSim's IEC default), scaled by the
+instantaneous hub-height wind."""
+
+
+def _shear_hub_loads(op: OperatingPoint | None, radius: float, strength: float):
+    """(force, moment) at the hub per unit dU/dy and per unit dU/dz (N·s, N·m·s), global axes."""
+    zero = (np.zeros(3), np.zeros(3))
+    if op is None or strength == 0.0:
+        return [zero, zero]
+    k_m = strength * ROTOR_ASYMMETRY["moment"] * op.dT_dV * radius**2
+    k_f = strength * ROTOR_ASYMMETRY["side_force"] * op.dQ_dV
+    per_gy = (np.zeros(3), np.array([0.0, 0.0, -k_m]))
+    per_gz = (np.array([0.0, -k_f, 0.0]), np.array([0.0, k_m, 0.0]))
+    return [per_gy, per_gz]
+
+
+def _tower_drag_strips(z0: float, z1: float, strength: float, n: int = 40):
+    """Strip heights (m) and drag force per unit ``V_hub |V_hub|`` (N s²/m²) of the tower."""
+    from .oc3 import RHO_AIR
+
+    edges = np.linspace(z0, z1, n + 1)
+    z = 0.5 * (edges[1:] + edges[:-1])
+    dz = np.diff(edges)
+    ta = TOWER_AERO
+    diam = ta["diameter_base"] + (ta["diameter_top"] - ta["diameter_base"]) * (z - z0) / (z1 - z0)
+    profile = (z / ta["hub_height"]) ** (2 * ta["shear_exponent"])
+    return z, strength * 0.5 * RHO_AIR * ta["cd"] * diam * dz * profile
 
 
 def _tower_labels(labels: list[str], freqs: np.ndarray) -> list[str]:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -24,16 +24,31 @@ import numba
 import numpy as np
 import scipy.linalg as sla
 
+from .aero import rotor_coefficients, rotor_table
 from .channels import ALL_CHANNELS, UNITS
+from .controller import DISCON, N_CONTROLLER_STATE, discon_step, initial_controller_state
+from .controller import PARAMS as DISCON_PARAMS
 from .load_cases import LoadCase
 from .model import INPUT_BLOCKS, N_INPUT, N_STATE, FOWTModel, LinearSystem, _as_case
-from .mooring import mooring_table
-from .oc3 import RHO_WATER
+from .mooring import mooring_loads, mooring_table
+from .oc3 import RHO_AIR, RHO_WATER
 from .record import Record
 from .structure import N_DOF
 from .validation import check_number
 from .waves import SparGeometry, synthesize_waves
 from .wind import synthesize_wind
+
+
+def mean_shear_z(wind_speed: float, exponent: float = 0.2, hub_height: float = 90.0, radius: float = 63.0) -> float:
+    """Vertical gradient (1/s) of the plane fitted over the rotor disc to the power-law profile
+    ``V (z/H)^exponent`` (area-weighted least squares: ``int z U dA / int z^2 dA``)."""
+    r = np.linspace(0.0, radius, 201)[1:]
+    a = np.linspace(0.0, 2 * np.pi, 181)[:-1]
+    rr, aa = np.meshgrid(r, a, indexing="ij")
+    z = rr * np.cos(aa)
+    u = wind_speed * ((hub_height + z) / hub_height) ** exponent
+    w = rr  # polar area element
+    return float(np.sum(w * z * u) / np.sum(w * z * z))
 
 __all__ = ["simulate", "Simulator", "MAX_INTERNAL_STEP", "MAX_SAMPLE_TIME"]
 
@@ -41,20 +56,57 @@ MAX_INTERNAL_STEP = 0.025
 """Largest internal integration step (s); longer sample times are subdivided."""
 MAX_SAMPLE_TIME = 0.15
 """Largest sample time (s): the 2nd tower modes (up to ~2.6 Hz) must lie below the Nyquist frequency."""
-N_EX = INPUT_BLOCKS["hub_wind"].stop  # exogenous (precomputed) inputs: const, wave(6), wind, elev, hub wind
+N_EX = INPUT_BLOCKS["shear"].stop  # exogenous (precomputed) inputs: const, wave(6), wind, elev, hub wind, shear(2)
 N_STRIPS = 24
+_PLATFORM_DOF = {"PtfmSurge": 0, "PtfmSway": 1, "PtfmHeave": 2, "PtfmRoll": 3, "PtfmPitch": 4, "PtfmYaw": 5}
+_INITIAL_CHANNELS = (*_PLATFORM_DOF, "TTDspFA", "TTDspSS", "RotSpeed")
 
 
 # ------------------------------------------------------------------------------------------------ kernel
+# scalar parameters of the kernel, packed in one float array ``par``
+P_DT, P_SMOOR, P_ZF, P_UNUSED, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
+    P_JREACT, P_GENEFF = range(15)
+N_PAR = 15
+I_WIND = INPUT_BLOCKS["wind"].start
+I_HUB_WIND = INPUT_BLOCKS["hub_wind"].start
+I_ACTION = INPUT_BLOCKS["action"].start
+I_HUB = INPUT_BLOCKS["hub"].start
+I_NL = INPUT_BLOCKS["nonlinear"].start
+I_ROTOR = INPUT_BLOCKS["rotor"].start
+
+
 @numba.njit(cache=True, nogil=True)
-def _nonlinear_and_hub(x, k, psi, vel, strip_z, drag_coef, moor_r, moor_h, moor_v, moor_k, zf, s_moor,
-                       harm, e_s, u):
-    """Fill u[10:28] (actions stay as set) with hub harmonic loads and nonlinear generalised forces."""
+def _mooring_generalised(x, gx, gy, gyaw, tab, zf, out):
+    """Mooring loads as generalised forces on the 6 platform DOFs about the SWL reference point: out[6:12]
+    (out[0:6] is scratch: the table's loads about the displaced fairlead centre)."""
+    dx = x[0] + zf * x[4]
+    dy = x[1] - zf * x[3]
+    mooring_loads(gx, gy, gyaw, tab, dx, dy, x[5], out[0:6])
+    lx, ly, lz = zf * x[4], -zf * x[3], zf  # fairlead centre relative to the displaced reference point
+    fx, fy, fz = out[0], out[1], out[2]
+    out[6] = fx
+    out[7] = fy
+    out[8] = fz
+    out[9] = out[3] + ly * fz - lz * fy
+    out[10] = out[4] + lz * fx - lx * fz
+    out[11] = out[5] + lx * fy - ly * fx
+
+
+@numba.njit(cache=True, nogil=True)
+def _loads(x, ctrl, k, psi, action, u_ex, vel, strip_z, drag_coef, moor_gx, moor_gy, moor_gyaw, moor_tab, moor_g0,
+           moor_jac, moor_out, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab, cq_tab, par, u):
+    """Fill u[10:] (actions, hub loads, nonlinear generalised forces, rotor outputs) from the state at the start
+    of a step; return the rotor acceleration (rad/s^2, 0 when the rotor is linear or parked)."""
     nd = 10
-    hub0 = 12
-    nl0 = 18
-    for i in range(hub0, nl0 + nd):
+    hub0 = I_HUB
+    nl0 = I_NL
+    rot0 = I_ROTOR
+    for i in range(hub0, u.shape[0]):
         u[i] = 0.0
+    u[I_ACTION] = action[0]
+    u[I_ACTION + 1] = action[1]
+    v_hub_wind = u_ex[k, I_HUB_WIND]
+    u[rot0 + 4] = v_hub_wind * abs(v_hub_wind)
     # --- quadratic drag on the relative velocity, strip by strip
     if drag_coef.shape[0] > 0:
         for j in range(strip_z.shape[0]):
@@ -70,31 +122,44 @@ def _nonlinear_and_hub(x, k, psi, vel, strip_z, drag_coef, moor_r, moor_h, moor_
             u[nl0 + 1] += fy
             u[nl0 + 3] += -z * fy
             u[nl0 + 4] += z * fx
-    # --- catenary mooring beyond the linear tangent stiffness, at the fairlead
+    # --- catenary mooring: table loads on (fairlead offset, yaw), minus their own linearisation (which the
+    #     linear stiffness already holds)
+    s_moor = par[P_SMOOR]
     if s_moor > 0.0:
-        xf = x[0] + zf * x[4]
-        yf = x[1] - zf * x[3]
-        rho = math.sqrt(xf * xf + yf * yf)
-        if rho > 1e-12:
-            n = moor_r.shape[0]
-            if rho >= moor_r[n - 1]:
-                slope_h = (moor_h[n - 1] - moor_h[n - 2]) / (moor_r[n - 1] - moor_r[n - 2])
-                slope_v = (moor_v[n - 1] - moor_v[n - 2]) / (moor_r[n - 1] - moor_r[n - 2])
-                h = moor_h[n - 1] + slope_h * (rho - moor_r[n - 1])
-                v = moor_v[n - 1] + slope_v * (rho - moor_r[n - 1])
-            else:
-                i = int(rho / moor_r[1])
-                w = (rho - moor_r[i]) / (moor_r[i + 1] - moor_r[i])
-                h = moor_h[i] + w * (moor_h[i + 1] - moor_h[i])
-                v = moor_v[i] + w * (moor_v[i + 1] - moor_v[i])
-            excess = s_moor * (h - moor_k * rho)
-            fx = -excess * xf / rho
-            fy = -excess * yf / rho
-            u[nl0 + 0] += fx
-            u[nl0 + 1] += fy
-            u[nl0 + 2] += -s_moor * v
-            u[nl0 + 3] += -zf * fy
-            u[nl0 + 4] += zf * fx
+        _mooring_generalised(x, moor_gx, moor_gy, moor_gyaw, moor_tab, par[P_ZF], moor_out)
+        for i in range(6):
+            acc = moor_out[6 + i] - moor_g0[i]
+            for j in range(6):
+                acc += moor_jac[i, j] * x[j]
+            u[nl0 + i] += s_moor * acc
+    # --- nonlinear rotor: Ct/Cq surfaces at the wind relative to the moving hub, DISCON's torque and pitch
+    domega = 0.0
+    if par[P_ROTOR] > 0.0:
+        v_hub = 0.0
+        theta = 0.0
+        for i in range(nd):
+            v_hub += h_v[i] * x[nd + i]
+            theta += r_pitch[i] * x[i]
+        wind = u_ex[k, I_WIND] + par[P_V0]
+        vn = wind * math.cos(par[P_TILT] - theta) - par[P_SAERO] * v_hub  # shaft elevation: tilt - pitch
+        omega = par[P_OMEGA0] + x[2 * nd]
+        pitch = ctrl[2] + action[0]
+        lam = omega * par[P_RADIUS] / max(abs(vn), 0.1)
+        ct, cq = rotor_coefficients(tsr_grid, pitch_grid, ct_tab, cq_tab, lam, pitch)
+        qdyn = par[P_QAREA] * vn * abs(vn)
+        thrust = qdyn * ct
+        q_aero = qdyn * par[P_RADIUS] * cq
+        q_gen_hss = ctrl[3] + action[1] / par[P_NGEAR]
+        q_gen = par[P_NGEAR] * q_gen_hss
+        domega = (q_aero - q_gen) / par[P_J]
+        reaction = q_gen + par[P_JREACT] * domega  # torque the drivetrain puts on the nacelle about the shaft
+        for a in range(3):
+            u[hub0 + a] += thrust * e_s[a]
+            u[hub0 + 3 + a] += reaction * e_s[a]
+        u[rot0 + 0] = pitch
+        u[rot0 + 1] = q_gen_hss
+        u[rot0 + 2] = q_gen * omega * par[P_GENEFF]
+        u[rot0 + 3] = thrust
     # --- rotor harmonics: harm = [T0, Q0, R, Omega0, a3, a6, aq, am, a1, b1, mi] (strengths applied)
     t0 = harm[0]
     if t0 != 0.0:
@@ -113,46 +178,54 @@ def _nonlinear_and_hub(x, k, psi, vel, strip_z, drag_coef, moor_r, moor_h, moor_
         u[hub0 + 2] += cent * c1
         u[hub0 + 4] += tr * (harm[7] * c3 + harm[9] * c1)
         u[hub0 + 5] += tr * (harm[7] * s3 + harm[9] * s1)
+    return domega
 
 
 @numba.njit(cache=True, nogil=True)
-def _advance(x, psi, k0, n_steps, every, phi, g_rest, exo, action, vel, strip_z, drag_coef, moor_r, moor_h,
-             moor_v, moor_k, zf, s_moor, harm, e_s, dt, x_hist, u_hist, out0):
+def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, vel, strip_z, drag_coef, moor_gx,
+             moor_gy, moor_gyaw, moor_tab, moor_g0, moor_jac, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab,
+             cq_tab, discon, par, x_hist, u_hist, out0):
     """Advance ``n_steps`` internal steps from step index ``k0``.
 
-    ``exo[k]`` is the precomputed contribution of the exogenous inputs to ``x[k+1]``. Every ``every`` steps the
-    state and the per-step inputs (actions, hub loads, nonlinear forces) are stored in ``x_hist[out0 + i]`` and
-    ``u_hist[out0 + i]`` (outputs are formed from them afterwards by one matrix product). ``x`` is updated in
-    place; the new rotor azimuth is returned.
+    ``exo[k]`` is the precomputed contribution of the exogenous inputs to ``x[k+1]``; ``u_ex[k]`` the exogenous
+    inputs themselves (the nonlinear rotor reads the wind from them). Every ``every`` steps the state and the
+    per-step inputs (actions, hub loads, nonlinear forces, rotor outputs) are stored in ``x_hist[out0 + i]``
+    and ``u_hist[out0 + i]`` (outputs are formed from them afterwards by one matrix product). ``x`` and the
+    controller state ``ctrl`` are updated in place; the new rotor azimuth is returned.
     """
     n_x = x.shape[0]
     n_r = g_rest.shape[1]
-    u = np.zeros(10 + n_r)
+    u = np.zeros(N_EX + n_r)
     xn = np.zeros(n_x)
     n_out = 0
+    dt = par[P_DT]
+    rotor = par[P_ROTOR] > 0.0
+    moor_out = np.zeros(12)
     for step in range(n_steps):
         k = k0 + step
-        u[10] = action[0]
-        u[11] = action[1]
-        _nonlinear_and_hub(x, k, psi, vel, strip_z, drag_coef, moor_r, moor_h, moor_v, moor_k, zf, s_moor,
-                           harm, e_s, u)
+        domega = _loads(x, ctrl, k, psi, action, u_ex, vel, strip_z, drag_coef, moor_gx, moor_gy, moor_gyaw,
+                        moor_tab, moor_g0, moor_jac, moor_out, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab,
+                        cq_tab, par, u)
         if step % every == 0:
             row = out0 + n_out
             for i in range(n_x):
                 x_hist[row, i] = x[i]
             for i in range(n_r):
-                u_hist[row, i] = u[10 + i]
+                u_hist[row, i] = u[N_EX + i]
             n_out += 1
         for r in range(n_x):
             acc = exo[k, r]
             for i in range(n_x):
                 acc += phi[r, i] * x[i]
             for i in range(n_r):
-                acc += g_rest[r, i] * u[10 + i]
+                acc += g_rest[r, i] * u[N_EX + i]
             xn[r] = acc
         psi += (harm[3] + x[20]) * dt
         for r in range(n_x):
             x[r] = xn[r]
+        if rotor:
+            x[20] += domega * dt
+            discon_step(discon, ctrl, par[P_NGEAR] * (par[P_OMEGA0] + x[20]), dt)
     return psi
 
 
@@ -212,12 +285,14 @@ class Simulator:
         self.dt = dt
         self.substeps = max(1, math.ceil(dt / MAX_INTERNAL_STEP - 1e-9))
         self.dt_int = dt / self.substeps
-        self.system = model.system(self.case)
+        eff = model.effects
+        self.nonlinear_rotor = eff["rotor_nonlinear"] > 0
+        self.system = model._system(self.case, nonlinear_rotor=self.nonlinear_rotor)
+        self.nonlinear_rotor = self.nonlinear_rotor and self.system.op is not None
         disc = _discretise(self.system, self.dt_int)
         self.phi, self.g_ex0, self.g_ex1, self.g_rest = disc.phi, disc.g_ex0, disc.g_ex1, disc.g_rest
         self.cy = np.ascontiguousarray(self.system.C)
         self.dy = np.ascontiguousarray(self.system.D)
-        eff = model.effects
         st = self.system.structure
         geo = SparGeometry()
         z, dz, diam = geo.strips(N_STRIPS)
@@ -226,13 +301,16 @@ class Simulator:
         self.drag_coef = (0.5 * RHO_WATER * geo.cd * np.asarray(diam) * np.asarray(dz) * s_drag
                           if s_drag > 0 else np.zeros(0))
         tab = mooring_table()
-        self.moor_r = tab.offset.astype(float)
-        self.moor_h = tab.horizontal_force.astype(float)
-        self.moor_v = tab.vertical_force.astype(float)
-        self.moor_k = float(st.data.mooring_stiffness[0, 0])
-        self.zf = float(tab.fairlead_z)
-        self.s_moor = float(eff["mooring_nonlinear"])
+        self.moor_grids = tuple(np.ascontiguousarray(g, dtype=float) for g in (tab.grid_dx, tab.grid_dy, tab.grid_yaw))
+        self.moor_tab = np.ascontiguousarray(tab.table, dtype=float)
+        zf = float(tab.fairlead_z)
+        self.moor_g0, self.moor_jac = self._mooring_linearisation(zf)
         self.e_s = np.ascontiguousarray(st.shaft_axis, dtype=float)
+        self.h_v = np.ascontiguousarray(st.shaft_axis @ st.hub_translation, dtype=float)
+        self.r_pitch = np.ascontiguousarray(st.tower_top_rotation[1], dtype=float)
+        rt = rotor_table()
+        self.rotor_grids = (np.ascontiguousarray(rt.tsr, dtype=float), np.ascontiguousarray(rt.pitch_rad, dtype=float),
+                            np.ascontiguousarray(rt.ct, dtype=float), np.ascontiguousarray(rt.cq, dtype=float))
         h = model.harmonics
         op = self.system.op
         s3, s1 = eff["rotor_3p"], eff["rotor_1p"]
@@ -241,19 +319,127 @@ class Simulator:
             self.system.rotor_speed, s3 * h.thrust_3p, s3 * h.thrust_6p, s3 * h.torque_3p, s3 * h.moment_3p,
             s1 * h.thrust_1p, s1 * h.moment_1p, s1 * h.mass_imbalance,
         ])
-        self.x_eq = self.system.equilibrium(self._nonlinear_static)
+        d = st.data
+        par = np.zeros(N_PAR)
+        par[P_DT] = self.dt_int
+        par[P_SMOOR] = float(eff["mooring_nonlinear"])
+        par[P_ZF] = zf
+        par[P_ROTOR] = 1.0 if self.nonlinear_rotor else 0.0
+        par[P_V0] = self.case.wind_speed if self.case is not None else 0.0
+        par[P_OMEGA0] = self.system.rotor_speed
+        par[P_J] = st.rotor_inertia_lss
+        par[P_NGEAR] = d.gearbox_ratio
+        par[P_RADIUS] = rt.radius
+        par[P_QAREA] = 0.5 * RHO_AIR * np.pi * rt.radius**2
+        par[P_SAERO] = float(eff["aero_damping"])
+        par[P_TILT] = d.shaft_tilt_rad
+        par[P_JREACT] = d.gearbox_ratio * (d.gearbox_ratio - 1.0) * d.generator_inertia
+        par[P_GENEFF] = DISCON["GenEff"]
+        self.par = par
+        self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
+        if op is not None:
+            self.ctrl0 = initial_controller_state(d.gearbox_ratio * op.rotor_speed, op.pitch)
+        else:
+            self.ctrl0 = np.zeros(N_CONTROLLER_STATE)
+        self.mean_shear = np.zeros(2)
+        if self.case is not None and self.case.wind_speed > 0:
+            self.mean_shear[1] = mean_shear_z(self.case.wind_speed)
+        self.x_eq = self._equilibrium()
 
     # ------------------------------------------------------------------------------------------ helpers
-    def _nonlinear_static(self, x: np.ndarray) -> np.ndarray:
+    def _mooring_linearisation(self, zf: float) -> tuple[np.ndarray, np.ndarray]:
+        """Generalised mooring load at zero offset and its Jacobian (central differences on the same table)."""
+        out = np.zeros(12)
+        gx, gy, gyaw = self.moor_grids
+
+        def g(q6: np.ndarray) -> np.ndarray:
+            x = np.zeros(N_STATE)
+            x[:6] = q6
+            _mooring_generalised(x, gx, gy, gyaw, self.moor_tab, zf, out)
+            return out[6:12].copy()
+
+        g0 = g(np.zeros(6))
+        jac = np.zeros((6, 6))
+        for j, hstep in enumerate((0.5, 0.5, 0.0, 0.005, 0.005, 0.01)):
+            if hstep == 0.0:
+                continue
+            e = np.zeros(6)
+            e[j] = hstep
+            jac[:, j] = (g(e) - g(-e)) / (2 * hstep)
+        return g0, np.ascontiguousarray(-jac)
+
+    def loads(self, x: np.ndarray, k: int, psi: float, action: np.ndarray, u_ex: np.ndarray, vel: np.ndarray,
+              ctrl: np.ndarray) -> tuple[np.ndarray, float]:
+        """Per-step inputs ``u`` (N_INPUT,) and rotor acceleration at state ``x`` and forcing sample ``k``."""
         u = np.zeros(N_INPUT)
+        domega = _loads(x, ctrl, k, psi, np.asarray(action, float), u_ex, vel, self.strip_z, self.drag_coef,
+                        *self.moor_grids, self.moor_tab, self.moor_g0, self.moor_jac, np.zeros(12), self.harm,
+                        self.e_s, self.h_v, self.r_pitch, *self.rotor_grids, self.par, u)
+        return u, domega
+
+    def _equilibrium(self) -> np.ndarray:
+        """Static equilibrium under the mean loads, the mean rotor loads and the static nonlinear forces."""
+        a_qq = self.system.A[N_DOF:2 * N_DOF, :N_DOF]
+        b_c = self.system.B[N_DOF:2 * N_DOF, 0]
+        b_rest = self.system.B[N_DOF:2 * N_DOF, N_EX:]
+        b_ex = self.system.B[N_DOF:2 * N_DOF, 1:N_EX]
+        u_ex = np.zeros((1, N_EX))
+        u_ex[0, 0] = 1.0
+        if self.case is not None:
+            u_ex[0, INPUT_BLOCKS["hub_wind"].start] = self.case.wind_speed
+        u_ex[0, INPUT_BLOCKS["shear"]] = self.mean_shear
         vel = np.zeros((1, self.strip_z.size, 2))
-        xs = x.copy()
-        xs[N_DOF:] = 0.0
-        harm = self.harm.copy()
-        harm[0] = 0.0  # the mean of the harmonics is zero
-        _nonlinear_and_hub(xs, 0, 0.0, vel, self.strip_z, self.drag_coef, self.moor_r, self.moor_h, self.moor_v,
-                           self.moor_k, self.zf, self.s_moor, harm, self.e_s, u)
-        return u[INPUT_BLOCKS["nonlinear"]]
+        harm = self.harm
+        self.harm = harm.copy()
+        self.harm[0] = 0.0  # the mean of the harmonics is zero
+        x = np.zeros(N_STATE)
+        try:
+            for _ in range(300):
+                u, _ = self.loads(x, 0, 0.0, np.zeros(2), u_ex, vel, self.ctrl0.copy())
+                q_new = -np.linalg.solve(a_qq, b_c + b_ex @ u_ex[0, 1:] + b_rest @ u[N_EX:])
+                done = np.max(np.abs(q_new - x[:N_DOF])) < 1e-10 * (1.0 + np.max(np.abs(q_new)))
+                x[:N_DOF] = 0.5 * (x[:N_DOF] + q_new)
+                if done:
+                    break
+        finally:
+            self.harm = harm
+        return x
+
+    def initial_state(self, initial: Mapping[str, float] | None) -> tuple[np.ndarray, np.ndarray]:
+        """State and controller state to start from: the equilibrium, with ``initial`` (OpenFAST channel name ->
+        value in OpenFAST units) overriding platform DOFs, tower-top deflections and the rotor speed."""
+        x = self.x_eq.copy()
+        ctrl = self.ctrl0.copy()
+        if not initial:
+            return x, ctrl
+        st = self.system.structure
+        t_top = st.point_translation(st.data.tower_top_height)
+        for name, value in dict(initial).items():
+            v = check_number(f"initial[{name!r}]", value)
+            if name in _PLATFORM_DOF:
+                i = _PLATFORM_DOF[name]
+                x[i] = v if i < 3 else np.deg2rad(v)
+            elif name in ("TTDspFA", "TTDspSS"):
+                mode = 6 if name == "TTDspFA" else 8
+                axis = 0 if name == "TTDspFA" else 1
+                x[mode] = (v - t_top[axis, 6:N_DOF] @ x[6:N_DOF] + t_top[axis, mode] * x[mode]) / t_top[axis, mode]
+            elif name == "RotSpeed":
+                if not self.system.op:
+                    raise ValueError("initial: RotSpeed needs an operating load case (the rotor is parked)")
+                x[2 * N_DOF] = v * np.pi / 30.0 - self.system.rotor_speed
+                ctrl[0] = st.data.gearbox_ratio * v * np.pi / 30.0
+            else:
+                raise ValueError(f"initial: unknown channel {name!r}; known: {sorted(_INITIAL_CHANNELS)}")
+        return x, ctrl
+
+    def advance(self, x: np.ndarray, ctrl: np.ndarray, psi: float, k0: int, n_steps: int, every: int,
+                exo: np.ndarray, u_ex: np.ndarray, action: np.ndarray, vel: np.ndarray, x_hist: np.ndarray,
+                u_hist: np.ndarray, out0: int) -> float:
+        """Run the compiled stepper (``x`` and ``ctrl`` in place); returns the new rotor azimuth (rad)."""
+        return _advance(x, ctrl, psi, k0, n_steps, every, self.phi, self.g_rest, exo, u_ex, action, vel,
+                        self.strip_z, self.drag_coef, *self.moor_grids, self.moor_tab, self.moor_g0, self.moor_jac,
+                        self.harm, self.e_s, self.h_v, self.r_pitch, *self.rotor_grids, self.discon, self.par,
+                        x_hist, u_hist, out0)
 
     def forcing(self, n_steps: int, seed_sequence: np.random.SeedSequence) -> tuple[np.ndarray, np.ndarray, float]:
         """Exogenous inputs for ``n_steps`` internal steps (+1 sample for the hold), strip velocities, azimuth."""
@@ -275,6 +461,7 @@ class Simulator:
                                  seed=int(wind_ss.generate_state(1)[0]))
             u_ex[:, INPUT_BLOCKS["wind"].start] = wd.rotor_effective[:n] - lc.wind_speed
             u_ex[:, INPUT_BLOCKS["hub_wind"].start] = wd.hub[:n]
+            u_ex[:, INPUT_BLOCKS["shear"].start + 1] = mean_shear_z(lc.wind_speed)
         psi0 = float(np.random.default_rng(psi_ss).uniform(0.0, 2.0 * np.pi))
         return np.ascontiguousarray(u_ex), vel, psi0
 
@@ -315,6 +502,7 @@ def simulate(
     transient: float = 60.0,
     noise: bool = True,
     return_truth: bool = False,
+    initial: Mapping[str, float] | None = None,
 ) -> Record | list[Record]:
     """Simulate the surrogate under a load case and return its 45 sensor channels.
 
@@ -338,6 +526,12 @@ def simulate(
         Add the model's sensor noise (:class:`surrogates.SensorNoise`).
     return_truth : bool
         If True, return ``(noisy, truth)`` pairs: the noise-free record alongside (a list of pairs for a batch).
+    initial : mapping, optional
+        Initial conditions for a free decay or a start-up, OpenFAST channel name -> value in OpenFAST units:
+        ``PtfmSurge``, ``PtfmSway``, ``PtfmHeave`` (m), ``PtfmRoll``, ``PtfmPitch``, ``PtfmYaw`` (deg),
+        ``TTDspFA``, ``TTDspSS`` (m, set through the first tower mode of that plane) and ``RotSpeed`` (rpm).
+        Unnamed states start at the static equilibrium. Use ``transient=0`` to record from the release, e.g.
+        ``simulate(model, None, 300, initial={"PtfmPitch": 5.0}, transient=0)``.
 
     Returns
     -------
@@ -368,14 +562,15 @@ def simulate(
     n_rec = n_out + n_skip
     out_steps = np.arange(n_skip, n_rec) * sim.substeps
 
+    x_start, ctrl_start = sim.initial_state(initial)
+
     def run_one(forcing_seq: np.random.SeedSequence) -> np.ndarray:
         u_ex, vel, psi0 = sim.forcing(n_steps, forcing_seq)
-        x = sim.x_eq.copy()
+        x, ctrl = x_start.copy(), ctrl_start.copy()
         x_hist = np.zeros((n_rec, N_STATE))
         u_hist = np.zeros((n_rec, N_INPUT - N_EX))
-        _advance(x, psi0, 0, n_steps, sim.substeps, sim.phi, sim.g_rest, sim.exogenous(u_ex), np.zeros(2), vel,
-                 sim.strip_z, sim.drag_coef, sim.moor_r, sim.moor_h, sim.moor_v, sim.moor_k, sim.zf, sim.s_moor,
-                 sim.harm, sim.e_s, sim.dt_int, x_hist, u_hist, 0)
+        sim.advance(x, ctrl, psi0, 0, n_steps, sim.substeps, sim.exogenous(u_ex), u_ex, np.zeros(2), vel, x_hist,
+                    u_hist, 0)
         return sim.outputs(x_hist[n_skip:], u_ex[out_steps], u_hist[n_skip:])
 
     # FFT synthesis, the compiled stepper (nogil) and BLAS all release the GIL: a batch runs on threads
@@ -398,6 +593,7 @@ def simulate(
             "transient": float(transient),
             "model": model.to_dict(),
             "noise": bool(noise),
+            "initial": dict(initial) if initial else None,
         }
         noisy = sim.add_noise(truth, ch[1]) if noise else truth
         rec = Record(t, noisy, list(ALL_CHANNELS), [UNITS[c] for c in ALL_CHANNELS], meta)

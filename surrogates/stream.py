@@ -19,7 +19,7 @@ from scipy.signal import lfilter
 from .channels import ALL_CHANNELS
 from .load_cases import LoadCase
 from .model import INPUT_BLOCKS, N_INPUT, N_STATE, FOWTModel
-from .simulate import N_EX, Simulator, _advance
+from .simulate import N_EX, Simulator
 
 __all__ = ["StreamingSimulator"]
 
@@ -93,6 +93,7 @@ class StreamingSimulator:
             mean[0] = 1.0
             if self.sim.case is not None and self.sim.case.wind_speed > 0:
                 mean[hub_w] = self.sim.case.wind_speed  # crossfade the turbulence, not the mean wind
+                mean[INPUT_BLOCKS["shear"]] = self.sim.mean_shear  # and the disc gradients' mean
             u_head = (tail_u - mean) * c[:, None] + (u_new[:n] - mean) * s[:, None] + mean
             v_head = tail_v * c[:, None, None] + v_new[:n] * s[:, None, None]
             u_new = np.concatenate([u_head, u_new[n:]])
@@ -123,7 +124,7 @@ class StreamingSimulator:
         self._noise_rng = np.random.default_rng(noise_seq)
         self._ar_state = self._col * self._noise_rng.standard_normal(len(self.channels))
         self.psi = float(np.random.default_rng(psi_seq).uniform(0.0, 2.0 * np.pi))
-        self.x = self.sim.x_eq.copy()
+        self.x, self.ctrl = self.sim.initial_state(None)
         self.time = 0.0
         self._tail = None
         self._next_chunk()
@@ -138,10 +139,8 @@ class StreamingSimulator:
         """Noise-free channel values at the current state (45,), with zero actions and current forcing."""
         x_hist = np.zeros((1, N_STATE))
         u_hist = np.zeros((1, N_INPUT - N_EX))
-        _advance(self.x.copy(), self.psi, self._k, 1, 1, self.sim.phi, self.sim.g_rest, self._exo, np.zeros(2),
-                 self._vel, self.sim.strip_z, self.sim.drag_coef, self.sim.moor_r, self.sim.moor_h, self.sim.moor_v,
-                 self.sim.moor_k, self.sim.zf, self.sim.s_moor, self.sim.harm, self.sim.e_s, self.sim.dt_int,
-                 x_hist, u_hist, 0)
+        self.sim.advance(self.x.copy(), self.ctrl.copy(), self.psi, self._k, 1, 1, self._exo, self._u, np.zeros(2),
+                         self._vel, x_hist, u_hist, 0)
         return self.sim.outputs(x_hist, self._u[self._k: self._k + 1], u_hist)[0]
 
     def advance(self, n_samples: int, action: np.ndarray, noise: bool = True) -> tuple[np.ndarray, np.ndarray]:
@@ -175,10 +174,9 @@ class StreamingSimulator:
                 continue
             m = min(room, n_samples - done)
             buf[done: done + m, N_STATE: N_STATE + N_EX] = self._u[self._k: self._k + m * self.substeps: self.substeps]
-            self.psi = _advance(self.x, self.psi, self._k, m * self.substeps, self.substeps, sim.phi, sim.g_rest,
-                                self._exo, act, self._vel, sim.strip_z, sim.drag_coef, sim.moor_r, sim.moor_h,
-                                sim.moor_v, sim.moor_k, sim.zf, sim.s_moor, sim.harm, sim.e_s, sim.dt_int, out_x,
-                                out_u, done)
+            self.psi = sim.advance(self.x, self.ctrl, self.psi, self._k, m * self.substeps, self.substeps,
+                                   self._exo, self._u, act, self._vel, out_x,
+                                   out_u, done)
             self._k += m * self.substeps
             done += m
         self.time += n_samples * self.dt

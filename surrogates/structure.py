@@ -215,7 +215,9 @@ def build_structure(n_tower_strips: int = 80, n_fe_elements: int = 40) -> Struct
 
     # --- rotor-nacelle assembly parts, rigid at the tower top: (name, mass, CM offset from tower top, inertia)
     tilt = d.shaft_tilt_rad
-    shaft = np.array([np.cos(tilt), 0.0, -np.sin(tilt)])  # downwind along the tilted shaft
+    # downwind along the tilted shaft: ElastoDyn's ShftTilt = -5 deg lifts the upwind (rotor) end, so the shaft
+    # descends downwind -- the same direction rotor_apex uses (the apex lies `overhang` < 0 along it)
+    shaft = np.array([np.cos(tilt), 0.0, np.sin(tilt)])
     apex = d.rotor_apex
     nac_offset2 = d.nacelle_cm[0] ** 2 + d.nacelle_cm[1] ** 2
     nac_iner = np.diag([0.0, 0.0, d.nacelle_yaw_inertia - d.nacelle_mass * nac_offset2])  # about its own CM

@@ -34,8 +34,8 @@ def test_channel_counts():
     assert len(tower_channels("FA")) == 18
     assert len(tower_channels("SS")) == 18
     assert len(tower_channels()) == 36
-    assert len(ALL_CHANNELS) == 45
-    assert len(set(ALL_CHANNELS)) == 45
+    assert len(ALL_CHANNELS) == 55
+    assert len(set(ALL_CHANNELS)) == 55
 
 
 def test_fa_planar_order_accelerations_then_moments():
