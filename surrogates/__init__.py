@@ -15,15 +15,17 @@ Examples
 (4800, 45)
 """
 
-from .channels import ALL_CHANNELS, GAUGE_HEIGHTS, UNITS, tower_channels
+from .channels import ALL_CHANNELS, GAUGE_HEIGHTS, OPENFAST_GAUGE_HEIGHTS, UNITS, tower_channels
 from .effects import EFFECTS, Effect
-from .load_cases import LOAD_CASES, LoadCase, load_case
+from .load_cases import LOAD_CASES, LoadCase, load_case, operating_case
 from .model import FOWTModel, LinearSystem, ModalResult, RotorHarmonics, SensorNoise
 from .record import Record
 from .simulate import Simulator, simulate
 from .stream import StreamingSimulator
 
 __all__ = [
+    "operating_case",
+    "OPENFAST_GAUGE_HEIGHTS",
     "ALL_CHANNELS",
     "EFFECTS",
     "Effect",

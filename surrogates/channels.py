@@ -40,6 +40,7 @@ from numpy.typing import NDArray
 __all__ = [
     "N_GAUGES",
     "GAUGE_HEIGHTS",
+    "OPENFAST_GAUGE_HEIGHTS",
     "PLANES",
     "tower_channels",
     "PLATFORM_CHANNELS",
@@ -59,6 +60,13 @@ N_GAUGES = 9
 GAUGE_HEIGHTS: NDArray[np.float64] = np.linspace(10.0, 87.6, N_GAUGES)
 """Heights of the tower gauges above still water level (m), gauge 1 (index 0) lowest; read-only."""
 GAUGE_HEIGHTS.flags.writeable = False
+
+OPENFAST_GAUGE_HEIGHTS: NDArray[np.float64] = 10.0 + 77.6 * np.array(
+    [0.025, 0.125, 0.275, 0.375, 0.475, 0.625, 0.725, 0.875, 0.975])
+"""Heights above still water (m) of the nine gauges of the shared OpenFAST OC3 Hywind runs: the centres of
+ElastoDyn tower nodes 1, 3, 6, 8, 10, 13, 15, 18, 20 of 20 (``TwrGagNd``), 11.94 ... 85.66 m; read-only. Pass
+them as ``FOWTModel(gauge_heights=OPENFAST_GAUGE_HEIGHTS)`` to compare gauge by gauge."""
+OPENFAST_GAUGE_HEIGHTS.flags.writeable = False
 
 PLANES = ("FA", "SS")
 """Names of the two bending planes: fore-aft (``xt``) and side-to-side (``yt``)."""

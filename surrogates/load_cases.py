@@ -49,6 +49,8 @@ __all__ = [
     "IEC_CLASS_B_I_REF",
     "PAPER_WIND_SPEED",
     "PAPER_ROTOR_RPM",
+    "operating_case",
+    "steady_rotor_rpm",
 ]
 
 DEFAULT_JONSWAP_GAMMA = 3.3
@@ -143,8 +145,11 @@ class LoadCase:
         90 = perpendicular (side-to-side).
     wind_speed : float
         Hub-height mean wind speed (m/s), >= 0.
-    rotor_rpm : float
-        Rotor speed (rpm), >= 0.
+    rotor_rpm : float or None
+        Rotor speed (rpm), >= 0 (0 = parked). None: the steady speed the OC3 Hywind controller reaches at
+        ``wind_speed`` (:func:`surrogates.aero.operating_point`); it then follows the wind speed in
+        :meth:`replace`. With the nonlinear rotor (the default) it is only the starting speed: the rotor speed is
+        a state driven by the aerodynamic and generator torques.
     turbulence_intensity : float
         Longitudinal turbulence intensity (-), 0 <= TI < 1 (0 = steady wind).
     gamma : float
@@ -175,7 +180,7 @@ class LoadCase:
     """Wave direction relative to the wind (deg)."""
     wind_speed: float
     """Hub-height mean wind speed (m/s)."""
-    rotor_rpm: float
+    rotor_rpm: float | None
     """Rotor speed (rpm)."""
     turbulence_intensity: float
     """Longitudinal turbulence intensity (-)."""
@@ -183,10 +188,17 @@ class LoadCase:
     """JONSWAP peak-enhancement factor (-)."""
     name: str = "custom"
     """Label of the load case."""
+    rotor_rpm_auto: bool = dataclasses.field(default=False, compare=False, repr=False)
+    """True when ``rotor_rpm`` was derived from the wind speed (it is recomputed when the wind speed changes)."""
 
     def __post_init__(self) -> None:
+        if self.rotor_rpm is None:
+            object.__setattr__(self, "rotor_rpm_auto", True)
+            object.__setattr__(self, "rotor_rpm", steady_rotor_rpm(_real(self.wind_speed, "wind_speed")))
         for field in dataclasses.fields(self):
-            if field.name != "name":
+            if field.name == "rotor_rpm_auto":
+                object.__setattr__(self, field.name, bool(self.rotor_rpm_auto))
+            elif field.name != "name":
                 object.__setattr__(self, field.name, _real(getattr(self, field.name), field.name))
         if not isinstance(self.name, str):
             raise ValueError(f"name must be a string, got {self.name!r} ({type(self.name).__name__})")
@@ -221,7 +233,8 @@ class LoadCase:
         dict
             ``{"hs": ..., "tp": ..., ..., "name": ...}``; :meth:`from_dict` inverts it exactly.
         """
-        return {field.name: getattr(self, field.name) for field in dataclasses.fields(self)}
+        return {field.name: getattr(self, field.name) for field in dataclasses.fields(self)
+                if field.name != "rotor_rpm_auto"}
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> LoadCase:
@@ -247,7 +260,7 @@ class LoadCase:
         unknown = sorted(set(data) - set(fields), key=str)
         if unknown:
             raise ValueError(f"data has unknown LoadCase field(s) {unknown}; expected keys from {fields}")
-        missing = [name for name in fields if name != "name" and name not in data]
+        missing = [name for name in fields if name not in ("name", "rotor_rpm_auto") and name not in data]
         if missing:
             raise ValueError(f"data misses LoadCase field(s) {missing}")
         return cls(**dict(data))
@@ -273,7 +286,64 @@ class LoadCase:
         unknown = sorted(set(changes) - set(fields))
         if unknown:
             raise ValueError(f"unknown LoadCase field(s) {unknown}; fields are {fields}")
+        if self.rotor_rpm_auto and "wind_speed" in changes and "rotor_rpm" not in changes:
+            changes["rotor_rpm"] = None  # the rotor speed follows the wind speed
         return dataclasses.replace(self, **changes)
+
+
+def steady_rotor_rpm(wind_speed: float) -> float:
+    """Steady rotor speed (rpm) of the NREL 5 MW under the OC3 Hywind controller at a mean wind (m/s); 0 for no
+    wind."""
+    if wind_speed <= 0.0:
+        return 0.0
+    from .aero import operating_point
+
+    return float(operating_point(float(wind_speed)).rotor_speed * 30.0 / math.pi)
+
+
+def operating_case(
+    wind_speed: float,
+    hs: float = 0.0,
+    tp: float = 10.0,
+    *,
+    gamma: float = 1.0,
+    wave_dir_deg: float = 0.0,
+    turbulence_intensity: float | None = None,
+    name: str = "custom",
+) -> LoadCase:
+    """A load case anywhere in the operating range: the rotor speed follows the wind speed.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Hub-height mean wind speed (m/s), > 0.
+    hs, tp : float
+        Significant wave height (m; 0 = still water) and peak period (s).
+    gamma : float
+        JONSWAP peak-enhancement factor (-); 1 (Pierson-Moskowitz) is what IEC 61400-3's rule gives for most
+        operational sea states (and what OpenFAST's ``WavePkShp = DEFAULT`` used in the reference runs).
+    wave_dir_deg : float
+        Wave direction relative to the wind (deg).
+    turbulence_intensity : float, optional
+        Default: IEC 61400-1 NTM, class B (:func:`iec_ntm_turbulence_intensity`).
+    name : str
+
+    Returns
+    -------
+    LoadCase
+
+    Examples
+    --------
+    >>> lc = operating_case(8.0, hs=2.0, tp=9.0)
+    >>> round(lc.rotor_rpm, 1), round(lc.replace(wind_speed=18.0).rotor_rpm, 1)
+    (9.1, 12.1)
+    """
+    v = _real(wind_speed, "wind_speed")
+    if v <= 0:
+        raise ValueError(f"wind_speed must be > 0 m/s for an operating case, got {v!r}")
+    ti = iec_ntm_turbulence_intensity(v) if turbulence_intensity is None else turbulence_intensity
+    return LoadCase(hs=hs, tp=tp, wave_dir_deg=wave_dir_deg, wind_speed=v, rotor_rpm=None, turbulence_intensity=ti,
+                    gamma=gamma, name=name)
 
 
 def _paper_case(n: int) -> LoadCase:
@@ -283,7 +353,7 @@ def _paper_case(n: int) -> LoadCase:
         tp=tp,
         wave_dir_deg=direction,
         wind_speed=PAPER_WIND_SPEED,
-        rotor_rpm=PAPER_ROTOR_RPM,
+        rotor_rpm=None,  # the controller's speed: 12.1 rpm at the paper's 12 m/s, and it follows replace()
         turbulence_intensity=iec_ntm_turbulence_intensity(PAPER_WIND_SPEED, IEC_CLASS_B_I_REF),
         gamma=DEFAULT_JONSWAP_GAMMA,
         name=f"OLC{n}",
