@@ -1172,7 +1172,8 @@ def validate(
         OpenFAST outputs of any readable format, each with a ``<run>.case.json`` sidecar
         (see :func:`load_reference`), e.g. ``shared/reference/openfast/runs``.
     model : surrogates.FOWTModel, optional
-        The surrogate; default ``surrogates.FOWTModel()`` (all effects).
+        The surrogate; default ``surrogates.FOWTModel(gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS)`` (all
+        effects, tower gauges at the shared OpenFAST runs' heights, 11.94 ... 85.66 m above MSL).
     seeds : int or sequence of int
         Number of seeds of the operating runs (``base_seed``, ``base_seed + 1``, ...) or the seeds themselves;
         default 8. The free decays are deterministic (no waves, no wind, no noise) and use one seed.
@@ -1213,7 +1214,9 @@ def validate(
     import surrogates
 
     t_start = time.perf_counter()
-    model = surrogates.FOWTModel() if model is None else model
+    if model is None:  # the gauges where the reference deck has them (TwrGagNd of the shared runs)
+        heights = getattr(surrogates, "OPENFAST_GAUGE_HEIGHTS", None)
+        model = surrogates.FOWTModel() if heights is None else surrogates.FOWTModel(gauge_heights=heights)
     seed_list = _seed_list(seeds, base_seed)
     if duration is not None and not (math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be > 0 s, got {duration!r}")
