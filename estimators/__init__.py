@@ -9,7 +9,8 @@ Never imports :mod:`surrogates` or Gymnasium: the same code runs on surrogate, O
   the rotor speed does), :func:`resample_to_azimuth`, :func:`rotor_azimuth`;
 * virtual sensors -- :class:`HankelDMDSensor` (causal rolling-horizon Hankel-DMD), :class:`KalmanSensor`
   (augmented Kalman filter on a linear model), :class:`KoopmanKalmanSensor` (Kalman filter on the identified
-  Hankel-DMD operator), :class:`HoldLastValue` (floor baseline);
+  Hankel-DMD operator), :class:`HoldLastValue` (floor baseline); all screen their live channels for stuck,
+  spiking and out-of-range values with one :class:`FaultScreen`;
 * scores -- :func:`r2_score`, :func:`nrmse`, :func:`reconstruction_scores` (the seed paper's definitions);
 * errors -- :class:`NotFittedError` (a ``ValueError``).
 """
@@ -31,11 +32,13 @@ from .metrics import nrmse, r2_score, reconstruction_scores
 from .modal import ModeShapeDistribution, mac, pair_modes, probabilistic_mode_shapes, real_mode_shape
 from .order_tracking import AngleDomainData, resample_to_azimuth, rotor_azimuth, rotor_harmonics
 from .preprocess import Preprocessor, band_sos, preprocess
+from .screening import FaultScreen
 from .ssi_cov import SSICov, correlation_sums
 from .validation import NotFittedError
 
 __all__ = [
     "AngleDomainData",
+    "FaultScreen",
     "HankelDMD",
     "HankelDMDSensor",
     "HoldLastValue",

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .screening import FaultScreen, make_screen
 from .validation import apply_masks, as_records
 
 __all__ = ["HoldLastValue"]
@@ -26,6 +27,10 @@ class HoldLastValue:
         What to report for a channel lost since the start of a stream: its mean in the training data
         (``"mean"``, needs :meth:`fit`), 0.0 (``"zero"``), or ``"auto"`` (default): the training mean once
         fitted, else 0.0. (0.0 for a tower-base moment of 5e4 kN m is a poor floor: fit it.)
+    screen : bool or FaultScreen
+        Once fitted, live values go through the fault screen shared by every sensor
+        (:class:`estimators.screening.FaultScreen`): a stuck, spiking or out-of-range live channel holds its last
+        good value instead of passing the fault through (``screen_.rejected_`` says which). False: off.
 
     Examples
     --------
@@ -38,8 +43,9 @@ class HoldLastValue:
     array([5., 2.])
     """
 
-    def __init__(self, fill: str = "auto") -> None:
+    def __init__(self, fill: str = "auto", screen: bool | FaultScreen = True) -> None:
         self.fill = fill
+        self.screen = screen
 
     def fit(self, Y: object, mask: object = None) -> HoldLastValue:
         """Learn the per-channel mean of the available training data (for ``fill="mean"``).
@@ -56,7 +62,9 @@ class HoldLastValue:
         -------
         self
         """
-        Y = np.concatenate(apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=1), mask), axis=0)
+        records = apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=1), mask)
+        self.screen_ = make_screen(self.screen, records)
+        Y = np.concatenate(records, axis=0)
         m = np.isfinite(Y)
         counts = m.sum(axis=0)
         self.mean_ = np.where(counts > 0, np.where(m, Y, 0.0).sum(axis=0) / np.maximum(counts, 1), 0.0)
@@ -66,6 +74,8 @@ class HoldLastValue:
     def reset(self) -> None:
         """Forget the held values."""
         self._last: np.ndarray | None = None
+        if hasattr(self, "screen_"):
+            self.screen_.reset()
 
     def update(self, y: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray:
         """One sample: available channels pass through, lost ones keep their last available value.
@@ -101,6 +111,8 @@ class HoldLastValue:
             else:
                 self._last = np.zeros(y.size)
         ok = mask & np.isfinite(y)
+        if hasattr(self, "screen_"):  # fitted: hold the last value that passed the fault screen
+            ok = self.screen_.screen(np.where(ok, y, np.nan), ok)
         self._last[ok] = y[ok]
         return self._last.copy()
 
@@ -117,4 +129,17 @@ class HoldLastValue:
             raise ValueError(f"mask must have the shape of Y {Y.shape} or ({Y.shape[1]},), got {mask.shape}")
         mask = np.broadcast_to(mask, Y.shape)
         self.reset()
-        return np.array([self.update(y, m) for y, m in zip(Y, mask, strict=True)])
+        out = np.empty_like(Y)
+        rejected = np.zeros(Y.shape, dtype=bool)
+        for k, (y, m) in enumerate(zip(Y, mask, strict=True)):
+            out[k] = self.update(y, m)
+            rejected[k] = self.rejected_
+        self.rejected_samples_ = rejected
+        return out
+
+    @property
+    def rejected_(self) -> np.ndarray:
+        """Live channels the fault screen rejected at the latest sample (none before :meth:`fit`)."""
+        if hasattr(self, "screen_"):
+            return self.screen_.rejected_.copy()
+        return np.zeros(self._last.size if getattr(self, "_last", None) is not None else 0, dtype=bool)

@@ -37,6 +37,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .hankel_dmd import HankelDMD
+from .screening import FaultScreen, make_screen
 from .validation import apply_masks, as_2d_float, as_records, check_fitted, check_number
 
 __all__ = ["HankelDMDSensor"]
@@ -86,6 +87,11 @@ class HankelDMDSensor:
         stuck value on a live channel then passes through: the gate protects only the lost channels).
     method : str
         Solver of the offline DMD (``"auto"``, ``"dense"``, ``"gram"``, ``"randomized"``).
+    screen : bool or FaultScreen
+        Fault screening of live channels (:class:`estimators.screening.FaultScreen`, shared by every sensor): a
+        flat-lined (stuck), spiking or out-of-range channel that still reports live is treated as lost at that
+        sample (estimated, not passed through) and reported in :attr:`rejected_`. True (default): default
+        settings; False: off; a ``FaultScreen``: its settings.
 
     Attributes
     ----------
@@ -108,6 +114,12 @@ class HankelDMDSensor:
         window for ``delays`` samples, so one spike may be counted at several calibrations).
     cache_info_ : dict
         ``hits``, ``misses`` and ``size`` of the window-pattern cache.
+    screen_ : FaultScreen
+        The fitted fault screen; its ``counts_`` say why channels were rejected.
+    rejected_ : ndarray of bool (n_channels,)
+        Live channels rejected by the screen at the latest sample.
+    rejected_samples_ : ndarray of bool (n_samples, n_channels)
+        After :meth:`reconstruct`: :attr:`rejected_` of every sample.
 
     Examples
     --------
@@ -136,6 +148,7 @@ class HankelDMDSensor:
         gate_sigma: float | None = 8.0,
         passthrough: bool = True,
         method: str = "auto",
+        screen: bool | FaultScreen = True,
     ) -> None:
         self.delays = delays
         self.rank = rank
@@ -146,6 +159,7 @@ class HankelDMDSensor:
         self.gate_sigma = gate_sigma
         self.passthrough = passthrough
         self.method = method
+        self.screen = screen
 
     # ------------------------------------------------------------------------------------------------ fit
     def fit(self, Y: object, mask: object = None) -> HankelDMDSensor:
@@ -173,6 +187,7 @@ class HankelDMDSensor:
         if not isinstance(self.causal, (bool, np.bool_)):
             raise ValueError(f"causal must be True or False, got {self.causal!r}")
         records = apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=2), mask)
+        self.screen_ = make_screen(self.screen, records)
         p = records[0].shape[1]
         finite = np.concatenate(records, axis=0)
         ok = np.isfinite(finite)
@@ -245,6 +260,19 @@ class HankelDMDSensor:
         self.n_open_loop_ = 0
         self.n_calibrations_ = 0
         self.n_gated_ = 0
+        self.screen_.reset()
+
+    @property
+    def rejected_(self) -> np.ndarray:
+        """Live channels rejected by the fault screen at the latest sample."""
+        check_fitted(self, "dmd_")
+        return self.screen_.rejected_.copy()
+
+    @property
+    def rejected_samples_(self) -> np.ndarray:
+        """After :meth:`reconstruct`: the channels the fault screen rejected at every sample."""
+        check_fitted(self, "dmd_")
+        return getattr(self.screen_, "rejected_samples_", None)
 
     @property
     def open_loop(self) -> bool:
@@ -365,6 +393,7 @@ class HankelDMDSensor:
             raise ValueError("causal=False is the look-ahead offline smoother; it needs the future and has no "
                              "update(): use reconstruct()")
         y, live = self._check_sample(y, mask)
+        live = self.screen_.screen(np.where(live, y, np.nan), live)
         z = np.where(live, (np.where(live, y, 0.0) - self.mean_) / self.scale_, 0.0)
         self._zbuf[self._pos] = z
         self._live[self._pos] = live
@@ -415,6 +444,7 @@ class HankelDMDSensor:
             if m.shape not in (Y.shape, (p,)):
                 raise ValueError(f"mask must have the shape of Y {Y.shape} or ({p},), got {m.shape}")
             live &= m.astype(bool)
+        live = self.screen_.screen_block(Y, live)
         n = Y.shape[0]
         Z = np.where(live, (np.where(live, Y, 0.0) - self.mean_) / self.scale_, 0.0)
         out = np.empty((n, p))

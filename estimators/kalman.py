@@ -53,6 +53,7 @@ from scipy.linalg.lapack import dtrtri as _dtrtri
 from scipy.signal import lfilter
 
 from .intervals import calibration_terms, model_error_std, unmeasured_std
+from .screening import FaultScreen, make_screen
 
 __all__ = ["KalmanSensor"]
 
@@ -123,6 +124,11 @@ class KalmanSensor:
     calibrate : bool
         Calibrate the standard deviations of unmeasured channels on the training data (default). False: the
         filter's own standard deviations (:attr:`interval_scale_` all ones).
+    screen : bool or FaultScreen
+        Fault screening of live channels before the filter (:class:`estimators.screening.FaultScreen`, shared by
+        every sensor): a flat-lined (stuck), spiking or out-of-range channel that still reports live is left out
+        of that sample and reported in :attr:`rejected_`. True (default): default settings; False: off (the
+        innovation gate still runs); a ``FaultScreen``: its settings.
 
     Attributes
     ----------
@@ -157,7 +163,15 @@ class KalmanSensor:
     n_gated_ : int
         Channel samples rejected by the innovation gate since :meth:`reset`.
     gated_counts_ : ndarray of int (n_channels,)
-        The same, per channel.
+        Channel samples rejected since :meth:`reset`, per channel, by the gate or the fault screen (see
+        :attr:`screen_`'s ``counts_`` for the reasons).
+    screen_ : FaultScreen
+        The fitted fault screen; its ``counts_`` say why channels were rejected (``"flat"``, ``"spike"``,
+        ``"range"``, ``"innovation"``).
+    rejected_ : ndarray of bool (n_channels,)
+        Live channels rejected at the latest sample (screen or gate).
+    rejected_samples_ : ndarray of bool (n_samples, n_channels)
+        After :meth:`reconstruct`: :attr:`rejected_` of every sample.
     n_blind_ : int
         Samples since :meth:`reset` at which no channel was used, so that the estimate is the model's pure
         prediction: no channel live (mask False or NaN everywhere), or every live one rejected by the gate.
@@ -238,6 +252,7 @@ class KalmanSensor:
         em_tol: float = 1e-3,
         max_fit_samples: int = 60_000,
         calibrate: bool = True,
+        screen: bool | FaultScreen = True,
     ) -> None:
         self.system = system
         self.dt = dt
@@ -251,6 +266,7 @@ class KalmanSensor:
         self.em_tol = em_tol
         self.max_fit_samples = max_fit_samples
         self.calibrate = calibrate
+        self.screen = screen
 
     # --------------------------------------------------------------------------------------------- model
     def _check_params(self) -> None:
@@ -393,6 +409,7 @@ class KalmanSensor:
         self._check_params()
         n_ch = self._c.shape[0]
         records = _as_records(Y, mask, n_ch)
+        self.screen_ = make_screen(self.screen, records)
         stacked = np.vstack(records)
         counts = np.isfinite(stacked).sum(axis=0)
         if np.any(counts < 2 * _DIFF_ORDER + 2):
@@ -707,6 +724,7 @@ class KalmanSensor:
         self.n_gated_ = 0
         self.gated_counts_ = np.zeros(self.n_channels_, dtype=int)
         self.n_blind_ = 0
+        self.screen_.reset()
         self._k, self._err_std = calibration_terms(self.interval_scale_, self.calibration_["loo_std"],
                                                    self.n_channels_)
         self.std_ = unmeasured_std(
@@ -764,6 +782,8 @@ class KalmanSensor:
             if mask.shape != (n_ch,):
                 raise ValueError(f"mask must have shape ({n_ch},) like y, got {mask.shape}")
             live = mask.astype(bool) & np.isfinite(y)
+        live = self.screen_.screen(np.where(np.isfinite(y), y, np.nan), live)
+        self.gated_counts_ += self.screen_.rejected_
         uk = None
         if u is not None:
             uk = np.asarray(u, dtype=float)
@@ -791,16 +811,25 @@ class KalmanSensor:
                 if gating:
                     # leave-one-out residual of each channel in standard deviations, (S^-1 e)_i / sqrt((S^-1)_ii):
                     # the channel against the prediction from the prior *and the other channels*
-                    loo = np.abs(ui @ we) / np.sqrt(np.einsum("ij,ij->i", ui, ui))
+                    with np.errstate(over="ignore", invalid="ignore"):
+                        loo = np.abs(ui @ we) / np.sqrt(np.einsum("ij,ij->i", ui, ui))
+                    loo = np.where(np.isnan(loo), np.inf, loo)  # an overflowed residual is an outlier, not NaN
                     worst = int(np.argmax(loo))
                     if loo[worst] > gate:
                         self.n_gated_ += 1
                         self.gated_counts_[idx[worst]] += 1
+                        self.screen_.note([idx[worst]])
                         keep = np.arange(e.size) != worst
                         idx, pht, s, e = idx[keep], pht[:, keep], s[np.ix_(keep, keep)], e[keep]
                         continue
                 w = ui.T @ pht.T  # U^-T H P: gain K = w' U^-T, K S K' = w' w
-                x = x + w.T @ we
+                with np.errstate(over="ignore", invalid="ignore"):
+                    x_new = x + w.T @ we
+                if not np.all(np.isfinite(x_new)):  # an update that overflows is no update: keep the prior
+                    self.screen_.note(idx, "range")
+                    self.gated_counts_[idx] += 1
+                    break
+                x = x_new
                 p = p - w.T @ w
                 p = 0.5 * (p + p.T)
                 updated = True
@@ -871,11 +900,20 @@ class KalmanSensor:
         self.reset()
         out = np.empty_like(Y)
         sd = np.empty_like(Y) if return_std else None
+        rejected = np.zeros(Y.shape, dtype=bool)
         for k in range(Y.shape[0]):
             out[k] = self.update(Y[k], mask[k], u=None if U is None else U[k])
+            rejected[k] = self.screen_.rejected_
             if sd is not None:
                 sd[k] = self.std_
+        self.rejected_samples_ = rejected
         return (out, sd) if return_std else out
+
+    @property
+    def rejected_(self) -> np.ndarray:
+        """Live channels rejected at the latest sample, by the fault screen or the innovation gate."""
+        self._check_fitted()
+        return self.screen_.rejected_.copy()
 
 
 # ------------------------------------------------------------------------------------------ exact filter tools

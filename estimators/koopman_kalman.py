@@ -90,6 +90,7 @@ from scipy.signal import lfilter
 
 from .hankel_dmd import HankelDMD
 from .intervals import calibration_terms, model_error_std, unmeasured_std
+from .screening import FaultScreen, make_screen
 from .validation import NotFittedError, apply_masks, as_records, check_int, check_number, split_at_nonfinite
 
 __all__ = ["KoopmanKalmanSensor"]
@@ -148,6 +149,11 @@ class KoopmanKalmanSensor:
         Calibrate the standard deviations of channels that are not used on the training data (default; see
         :meth:`_calibrate`). False: the filter's own standard deviations (:attr:`interval_scale_` all ones). The
         estimates are the same either way.
+    screen : bool or FaultScreen
+        Fault screening of live channels before the filter (:class:`estimators.screening.FaultScreen`, shared by
+        every sensor): a flat-lined (stuck), spiking or out-of-range channel that still reports live is left out
+        of that sample and reported in :attr:`rejected_`. True (default): default settings; False: off (the
+        innovation gate still runs); a ``FaultScreen``: its settings.
 
     Attributes
     ----------
@@ -185,7 +191,15 @@ class KoopmanKalmanSensor:
     n_gated_ : int
         Channel samples rejected by the innovation gate since :meth:`reset`.
     gated_counts_ : ndarray of int (n_channels,)
-        The same, per channel.
+        Channel samples rejected since :meth:`reset`, per channel, by the gate or the fault screen (see
+        :attr:`screen_`'s ``counts_`` for the reasons).
+    screen_ : FaultScreen
+        The fitted fault screen; its ``counts_`` say why channels were rejected (``"flat"``, ``"spike"``,
+        ``"range"``, ``"innovation"``).
+    rejected_ : ndarray of bool (n_channels,)
+        Live channels rejected at the latest sample (screen or gate).
+    rejected_samples_ : ndarray of bool (n_samples, n_channels)
+        After :meth:`reconstruct`: :attr:`rejected_` of every sample.
     n_blind_ : int
         Samples since :meth:`reset` at which no channel was used (none live, or every live one gated): the
         estimate is the model's prediction.
@@ -259,6 +273,7 @@ class KoopmanKalmanSensor:
         max_fit_samples: int = 40_000,
         max_modulus: float = 0.99999,
         calibrate: bool = True,
+        screen: bool | FaultScreen = True,
     ) -> None:
         self.delays = delays
         self.rank = rank
@@ -269,6 +284,7 @@ class KoopmanKalmanSensor:
         self.max_fit_samples = max_fit_samples
         self.max_modulus = max_modulus
         self.calibrate = calibrate
+        self.screen = screen
 
     # --------------------------------------------------------------------------------------------- checks
     def _check_params(self) -> tuple[float | None, float | None]:
@@ -316,6 +332,7 @@ class KoopmanKalmanSensor:
         """
         dt, _ = self._check_params()
         records = apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=1), mask)
+        self.screen_ = make_screen(self.screen, records)
         p = records[0].shape[1]
         finite = [np.isfinite(r) for r in records]
         counts = np.sum([f.sum(axis=0) for f in finite], axis=0)
@@ -565,6 +582,7 @@ class KoopmanKalmanSensor:
         self.n_gated_ = 0
         self.gated_counts_ = np.zeros(self.n_channels_, dtype=int)
         self.n_blind_ = 0
+        self.screen_.reset()
         self._k, self._err_std = calibration_terms(self.interval_scale_, self.calibration_["loo_std"],
                                                    self.n_channels_)
         self.std_ = unmeasured_std(self._std_of(self._P), self._k, self._err_std)
@@ -656,8 +674,11 @@ class KoopmanKalmanSensor:
         return self._step(y, live, return_std)
 
     def _step(self, y: np.ndarray, live: np.ndarray, return_std: bool):
+        live = self.screen_.screen(y, live)
+        self.gated_counts_ += self.screen_.rejected_
         r = self.rank_
-        x, P = self._x, self._P
+        x_prior = x = self._x
+        P = self._P
         gate = self._gate
         key = live.tobytes()
         used_key = None
@@ -675,10 +696,12 @@ class KoopmanKalmanSensor:
                     we = ss["ui"].T @ e
                     worst_ok = True
                     if gate is not None:
-                        loo = np.abs(ss["ui"] @ we) / ss["loo_norm"]
-                        worst_ok = not (loo.max() > gate)
+                        with np.errstate(over="ignore", invalid="ignore"):
+                            loo = np.abs(ss["ui"] @ we) / ss["loo_norm"]
+                        worst_ok = bool(loo.max() <= gate)  # NaN from an overflow is not ok
                     if worst_ok:
-                        x = x + ss["gain"] @ e
+                        with np.errstate(over="ignore", invalid="ignore"):
+                            x = x + ss["gain"] @ e
                         post_std = ss["std"]
                         used_key = key
                         used_idx = idx
@@ -696,16 +719,20 @@ class KoopmanKalmanSensor:
                         break
                     we = ui.T @ e
                     if gate is not None:
-                        loo = np.abs(ui @ we) / np.sqrt(np.einsum("ij,ij->i", ui, ui))
+                        with np.errstate(over="ignore", invalid="ignore"):
+                            loo = np.abs(ui @ we) / np.sqrt(np.einsum("ij,ij->i", ui, ui))
+                        loo = np.where(np.isnan(loo), np.inf, loo)  # an overflowed residual is an outlier
                         worst = int(np.argmax(loo))
                         if loo[worst] > gate:
                             self.n_gated_ += 1
                             self.gated_counts_[idx[sel[worst]]] += 1
+                            self.screen_.note([idx[sel[worst]]])
                             keep = np.arange(sel.size) != worst
                             sel, PHt, S, e = sel[keep], PHt[:, keep], S[np.ix_(keep, keep)], e[keep]
                             continue
                     W = ui.T @ PHt.T  # U^-T H P: gain K = W^T U^-T, K S K^T = W^T W
-                    x = x + W.T @ we
+                    with np.errstate(over="ignore", invalid="ignore"):
+                        x = x + W.T @ we
                     P_post = P - W.T @ W
                     P_post = 0.5 * (P_post + P_post.T)
                     used_idx = idx[sel]
@@ -719,6 +746,11 @@ class KoopmanKalmanSensor:
         else:
             P_post = P
             post_std = self._std_of(P)
+        if not np.all(np.isfinite(x)):  # an update that overflows is no update: keep the prior, drop the sample
+            x, P_post, post_std, used_key, used_idx = x_prior, P, self._std_of(P), None, None
+            self._steady = None
+            self.screen_.note(np.flatnonzero(live), "range")
+            self.gated_counts_[live] += 1
         if used_key is None:
             self.n_blind_ += 1
         est = self.mean_ + self.scale_ * (self._C @ x[:r])
@@ -823,11 +855,20 @@ class KoopmanKalmanSensor:
         self.reset()
         out = np.empty_like(Y)
         sd = np.empty_like(Y) if return_std else None
+        rejected = np.zeros(Y.shape, dtype=bool)
         for k in range(Y.shape[0]):
             out[k] = self._step(Y[k], live[k], False)
+            rejected[k] = self.screen_.rejected_
             if sd is not None:
                 sd[k] = self.std_
+        self.rejected_samples_ = rejected
         return (out, sd) if return_std else out
+
+    @property
+    def rejected_(self) -> np.ndarray:
+        """Live channels rejected at the latest sample, by the fault screen or the innovation gate."""
+        self._check_fitted()
+        return self.screen_.rejected_.copy()
 
 
 # ------------------------------------------------------------------------------------------------- helpers

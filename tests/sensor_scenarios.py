@@ -39,19 +39,21 @@ def scenario_record(surrogates, model, name: str, duration: float, seed: int = 7
 
 
 def check_spikes_are_gated(sensor, y: np.ndarray, truth: np.ndarray) -> None:
-    """Spikes (30 std) on 0.5 % of the live samples of scenario B: the gate catches them and keeps the hidden
-    channels as good as on clean data; without the gate they are worse."""
+    """Spikes (30 std) on 0.5 % of the live samples of scenario B: the fault screen and the gate catch them and
+    keep the hidden channels as good as on clean data; without either they are worse."""
     mask = hidden_b_mask(y.shape[0])
     rng = np.random.default_rng(7)
     spikes = (rng.random(y.shape) < 0.005) & mask
     y_spiky = y + spikes * rng.choice([-1.0, 1.0], size=y.shape) * 30.0 * sensor.scale_
     clean = r2_score(truth, sensor.reconstruct(y, mask))[HIDDEN_B]
     gated = r2_score(truth, sensor.reconstruct(y_spiky, mask))[HIDDEN_B]
-    assert sensor.n_gated_ >= 0.9 * spikes.sum()
+    assert sensor.gated_counts_.sum() >= 0.9 * spikes.sum()  # by the screen or the gate
+    assert (sensor.rejected_samples_ & spikes).sum() >= 0.9 * spikes.sum()  # and flagged where they are
     ungated_sensor = copy.deepcopy(sensor)
     ungated_sensor.gate_sigma = None
+    ungated_sensor.screen_.active = False
     ungated = r2_score(truth, ungated_sensor.reconstruct(y_spiky, mask))[HIDDEN_B]
-    assert ungated_sensor.n_gated_ == 0
+    assert ungated_sensor.n_gated_ == 0 and ungated_sensor.gated_counts_.sum() == 0
     print(f"\nspikes on 0.5% of live samples: hidden R2 clean {np.round(clean, 5)}, gated {np.round(gated, 5)}, "
           f"ungated {np.round(ungated, 5)}")
     assert np.all(gated > clean - 0.002)

@@ -197,11 +197,14 @@ def test_spikes_and_a_stuck_sensor_are_gated(spar):
     y_stuck = y.copy()
     y_stuck[800:, 4] = y[800, 4]  # gauge-5 accelerometer frozen from t = 10 s, still reported available
     stuck = r2_score(truth, sensor.reconstruct(y_stuck, mask))[hidden]
+    assert sensor.screen_.counts_["spike"].sum() + sensor.screen_.counts_["range"].sum() == 0  # (stuck run last)
     sensor.gate_sigma = None
+    sensor.screen_.active = False  # neither the gate nor the shared fault screen
     try:
         ungated = r2_score(truth, sensor.reconstruct(y_spiky, mask))[hidden]
     finally:
         sensor.gate_sigma = 8.0
+        sensor.screen_.active = True
     print(f"\nDMD sensor: hidden R2 clean {np.round(clean, 4)}, spikes gated {np.round(gated, 4)}, ungated "
           f"{np.round(ungated, 4)}, stuck sensor {np.round(stuck, 4)}")
     assert np.all(gated > clean - 0.005) and np.all(stuck > clean - 0.01)

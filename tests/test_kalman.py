@@ -295,11 +295,21 @@ def test_streaming_update_equals_reconstruct(oscillator):
 
 
 def test_gate_rejects_the_channel_that_disagrees_and_counts_unused_samples_as_blind(oscillator):
-    _, _, y_test, truth, sensor = oscillator
+    _, _, y_test, truth, screened = oscillator
     y = y_test[:400].copy()
-    y[300, 3] += 50.0 * sensor.scale_[3]  # a spike on the second accelerometer
+    y[300, 3] += 50.0 * screened.scale_[3]  # a spike on the second accelerometer
+    # the shared fault screen takes it out before the filter, and says so
+    est = screened.reconstruct(y)
+    assert screened.gated_counts_.tolist() == [0, 0, 0, 1] and screened.n_blind_ == 0
+    assert np.flatnonzero(screened.rejected_samples_.any(axis=1)).tolist() == [300]
+    assert np.all(np.abs(est[300] - truth[300]) < 0.05 * screened.scale_)
+    # without the screen, the innovation gate alone
+    sensor = copy.deepcopy(screened)
+    sensor.screen_.active = False
     est = sensor.reconstruct(y)
     assert sensor.n_gated_ == 1 and sensor.gated_counts_.tolist() == [0, 0, 0, 1] and sensor.n_blind_ == 0
+    assert sensor.rejected_samples_[300].tolist() == [False, False, False, True]
+    assert sensor.screen_.counts_["innovation"].tolist() == [0, 0, 0, 1]
     assert np.all(np.abs(est[300] - truth[300]) < 0.05 * sensor.scale_)
     # a single live channel, and it spikes: nothing usable at that sample, the estimate is the model's prediction
     mask = np.zeros(4, dtype=bool)
