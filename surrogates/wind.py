@@ -13,6 +13,9 @@ Model
 * Synthesis: per frequency, the 2x2 spectral matrix ``S [[1, G], [G, H2]]`` is factored as ``L L^T`` with
   ``L = sqrt(S) [[1, 0], [G, sqrt(H2 - G^2)]]`` and applied to two independent random-phase components of unit
   amplitude; one inverse real FFT per series.
+* Rotor-plane field (:func:`synthesize_rotor_wind`): the same spectrum and coherence on a polar grid of points
+  over the disc (Veers' method, as TurbSim's ``IECKAI`` model), plus the power-law mean profile; the linear
+  gradients of u over the disc (:func:`rotor_plane_fit`) drive the rotor's yaw and tilt moments and side force.
 
 Examples
 --------
@@ -34,10 +37,13 @@ from .validation import check_number
 
 __all__ = [
     "IEC_REFERENCE_INTENSITY",
+    "RotorWind",
     "WindSeries",
     "iec_turbulence_intensity",
     "kaimal_spectrum",
     "rotor_averaging",
+    "rotor_plane_fit",
+    "synthesize_rotor_wind",
     "synthesize_wind",
     "turbulence_length_scale",
 ]
@@ -383,3 +389,299 @@ def synthesize_wind(
     # irfft gives (1/N) sum_j X_j e^{2 pi i j m / N} + c.c.; the N/2 in amp makes it sum_j Re(X_j e^{i w_j t})
     series = irfft(spectra, n=n_fft, axis=-1)[:, :n_out] + v
     return WindSeries(t, series[0].copy(), series[1].copy(), freqs, meta)
+
+
+_COHERENCE_FLOOR = 1e-4  # above the frequency where all pairs' coherence is below this, points are independent
+_CHOLESKY_CHUNK = 512  # frequencies factored per batch (memory: chunk * n_points^2 * 8 bytes)
+
+
+def _polar_weights(radii: np.ndarray, n_azimuth: int, radius: float) -> np.ndarray:
+    """Area of the disc (m²) represented by one point of each ring: annuli with edges midway between rings."""
+    edges = np.concatenate([[0.0], 0.5 * (radii[1:] + radii[:-1]), [radius]])
+    ring_area = np.pi * (edges[1:] ** 2 - edges[:-1] ** 2)
+    return ring_area / n_azimuth
+
+
+def _check_polar_grid(radii: object, azimuth_rad: object, radius: float | None) -> tuple[np.ndarray, np.ndarray, float]:
+    r = np.asarray(radii, dtype=float)
+    psi = np.asarray(azimuth_rad, dtype=float)
+    if r.ndim != 1 or r.size < 2 or not np.all(np.isfinite(r)) or r[0] < 0 or np.any(np.diff(r) <= 0):
+        raise ValueError(f"radii must be >= 2 finite, increasing, non-negative radii (m), got {radii!r}")
+    if psi.ndim != 1 or psi.size < 3 or not np.all(np.isfinite(psi)):
+        raise ValueError(f"azimuth_rad must be >= 3 finite azimuths (rad), got {azimuth_rad!r}")
+    step = 2.0 * np.pi / psi.size
+    if not np.allclose(np.diff(psi), step, atol=1e-9):
+        raise ValueError("azimuth_rad must be uniformly spaced over the full circle (2 pi / n_azimuth apart)")
+    outer = float(r[-1]) if radius is None else check_number("radius", radius, positive=True)
+    if outer < r[-1]:
+        raise ValueError(f"radius ({outer} m) must be >= the largest ring radius ({r[-1]} m)")
+    return r, psi, outer
+
+
+def rotor_plane_fit(
+    polar_u: np.ndarray, radii: np.ndarray, azimuth_rad: np.ndarray, radius: float | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Area-weighted least-squares plane ``u ≈ U0 + Gy y + Gz z`` fitted to a wind field on a polar grid.
+
+    The grid is rings of radius ``radii`` (a ring of radius 0 is the hub, its azimuthal copies counted once in
+    area) times uniformly spaced azimuths ``psi`` measured from the top towards +y (port), so a point sits at
+    ``y = r sin(psi)``, ``z = r cos(psi)`` relative to the hub. Each point carries the area of its share of an
+    annulus whose edges lie midway between rings (the outer edge at ``radius``). With uniform azimuths ``1, y, z``
+    are orthogonal under these weights, so the fit decouples: ``U0 = sum(w u) / sum(w)`` (the area-weighted
+    disc mean), ``Gy = sum(w u y) / sum(w y^2)``, ``Gz = sum(w u z) / sum(w z^2)``.
+
+    A rotor responds to these gradients: yaw moment proportional to ``-Gy``, tilt moment to ``+Gz`` and side
+    force to ``-Gz`` (through the blades' rotational sampling).
+
+    Parameters
+    ----------
+    polar_u : array_like, shape (n_t, n_radii, n_azimuth)
+        Streamwise wind (m/s) on the grid, time-major.
+    radii : array_like, shape (n_radii,)
+        Ring radii (m), increasing, >= 0.
+    azimuth_rad : array_like, shape (n_azimuth,)
+        Azimuths (rad) from the top towards +y, uniformly spaced over the circle (>= 3).
+    radius : float, optional
+        Outer radius of the disc (m), >= ``radii[-1]``; default ``radii[-1]``.
+
+    Returns
+    -------
+    mean, shear_y, shear_z : ndarray, shape (n_t,)
+        Disc mean (m/s) and the horizontal (towards +y) and vertical (upwards) gradients (1/s).
+
+    Examples
+    --------
+    >>> r, psi = np.array([0.0, 30.0, 60.0]), np.arange(8) * np.pi / 4
+    >>> z = r[:, None] * np.cos(psi)[None, :]
+    >>> mean, gy, gz = rotor_plane_fit((10.0 + 0.02 * z)[None], r, psi, radius=63.0)
+    >>> float(mean[0]), abs(float(gy[0])) < 1e-15, round(float(gz[0]), 12)
+    (10.0, True, 0.02)
+    """
+    r, psi, outer = _check_polar_grid(radii, azimuth_rad, radius)
+    u = np.asarray(polar_u)
+    if u.ndim != 3 or u.shape[1:] != (r.size, psi.size):
+        raise ValueError(f"polar_u must have shape (n_t, {r.size}, {psi.size}), got {u.shape}")
+    w = _polar_weights(r, psi.size, outer)  # per point of each ring
+    ring_sum = u.sum(axis=2, dtype=float)
+    ring_sin = u @ np.sin(psi)
+    ring_cos = u @ np.cos(psi)
+    mean = ring_sum @ w / (w.sum() * psi.size)
+    wr = w * r
+    shear_y = ring_sin @ wr / (np.sum(wr * r) * np.sum(np.sin(psi) ** 2))
+    shear_z = ring_cos @ wr / (np.sum(wr * r) * np.sum(np.cos(psi) ** 2))
+    return mean, shear_y, shear_z
+
+
+@dataclass(frozen=True)
+class RotorWind:
+    """Streamwise wind over the rotor disc reduced to its mean and linear gradients (SI units, time-major).
+
+    Attributes
+    ----------
+    t : ndarray (n,)
+        Time (s), ``t[i] = i dt``.
+    hub : ndarray (n,)
+        Streamwise wind at the hub point (m/s, mean included).
+    rotor_effective : ndarray (n,)
+        Area-weighted mean of u over the disc (m/s, mean profile included).
+    shear_y : ndarray (n,)
+        Horizontal gradient dU/dy of the plane fitted to u over the disc (1/s; y to port).
+    shear_z : ndarray (n,)
+        Vertical gradient dU/dz of that plane (1/s; z up), mean shear of the power-law profile included.
+    polar_u : ndarray (n, n_radii, n_azimuth) of float32, or None
+        The synthesised field on the polar grid (m/s); ``None`` when ``return_field=False``. The ring of
+        radius 0 is the hub, repeated over azimuth.
+    polar_radii : ndarray (n_radii,)
+        Ring radii (m), from 0 (hub) to the rotor radius.
+    polar_azimuth_rad : ndarray (n_azimuth,)
+        Azimuths (rad) from the top towards +y (port): a point is at ``y = r sin(psi)``, ``z = H + r cos(psi)``.
+    meta : dict
+        ``mean_speed, turbulence_intensity, shear_exponent, hub_height, radius, seed`` (None unless an int was
+        given), ``dt, n_fft, n_points, coherent_max_hz`` (above it the grid points are synthesised independently).
+
+    Examples
+    --------
+    >>> w = synthesize_rotor_wind(10.0, 0.0, duration=2.0, dt=0.5, seed=0, shear_exponent=0.0)
+    >>> w.hub.tolist() == [10.0] * 4 and float(np.abs(w.shear_z).max()) < 1e-12
+    True
+    """
+
+    t: np.ndarray
+    hub: np.ndarray
+    rotor_effective: np.ndarray
+    shear_y: np.ndarray
+    shear_z: np.ndarray
+    polar_u: np.ndarray | None
+    polar_radii: np.ndarray
+    polar_azimuth_rad: np.ndarray
+    meta: dict = field(default_factory=dict)
+
+
+def _check_count(name: str, value: object, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def synthesize_rotor_wind(
+    mean_speed: float,
+    turbulence_intensity: float,
+    duration: float,
+    dt: float,
+    seed: int | np.random.SeedSequence | np.random.Generator | None = 0,
+    *,
+    shear_exponent: float = 0.2,
+    hub_height: float = 90.0,
+    radius: float = 63.0,
+    n_radii: int = 5,
+    n_azimuth: int = 12,
+    return_field: bool = True,
+) -> RotorWind:
+    """Synthesise the streamwise wind over the rotor disc (Veers' method) and its mean and linear gradients.
+
+    Model (that of TurbSim's ``IECKAI`` model for the u component):
+
+    * every point has the IEC 61400-1 ed. 3 Kaimal spectrum :func:`kaimal_spectrum` with the hub-height
+      ``sigma = TI V`` (uniform over the disc) and the hub-height length scale;
+    * two points a distance r apart have the IEC coherence ``exp(-12 sqrt((f r / V)^2 + (0.12 r / L_c)^2))``,
+      ``L_c = 8.1 Lambda_1`` (:func:`turbulence_length_scale`; TurbSim prints it as the u-coherence parameters
+      ``(12, 0.12 / L_c)``), real (no phase);
+    * the mean power-law profile ``V ((H + z) / H)^alpha`` is added.
+
+    The points form a polar grid: the hub and ``n_radii - 1`` rings at radii ``k R / (n_radii - 1)``, each with
+    ``n_azimuth`` points from the top towards +y. Per frequency of the FFT grid the coherence matrix is factored
+    ``C = L L^T`` (Cholesky) and the points' Fourier coefficients are ``sqrt(2 S df) L z`` with ``z`` independent
+    unit-amplitude components of uniform random phase; one inverse real FFT per point gives its series. Above
+    ``coherent_max_hz = V ln(1e4) / (12 d_min)`` (``d_min`` the closest pair of points) every coherence is below
+    1e-4, ``L`` is the identity to that accuracy and the points are synthesised independently, so the spectrum
+    reaches the Nyquist frequency ``1 / (2 dt)`` at the cost of an FFT per point (the Cholesky factors are only
+    needed up to about 1-2 Hz). As in :func:`synthesize_wind` the series are the first ``n = round(duration/dt)``
+    samples of a record periodic over ``n_fft = next_fast_len(n)``; variance below ``df`` and at the Nyquist
+    frequency is absent.
+
+    The disc mean and gradients come from :func:`rotor_plane_fit` on the grid (area weights). With the default
+    5 x 12 grid their variances are within about 1 % of those of the continuous disc (checked against a
+    24 x 64 grid). The power-law profile's plane fit gives a mean ``shear_z`` slightly above ``alpha V / H``: at
+    12 m/s 0.0286 1/s over the continuous disc (0.0288 on the default grid) against 0.0267 1/s.
+
+    Parameters
+    ----------
+    mean_speed : float
+        Mean wind at hub height V (m/s), >= 0 (0 gives calm air).
+    turbulence_intensity : float
+        TI = sigma / V at hub height (-), 0 <= TI < 1; 0 gives the steady sheared wind.
+    duration : float
+        Record length (s), >= dt.
+    dt : float
+        Sample time (s), > 0.
+    seed : int, SeedSequence, Generator or None, default 0
+        Source of the random phases; the same seed gives the same bytes.
+    shear_exponent : float, default 0.2
+        Power-law exponent alpha of the mean profile (-), >= 0 (IEC 61400-1 NTM: 0.2).
+    hub_height : float, default 90
+        Hub height H (m), > ``radius``.
+    radius : float, default 63
+        Rotor radius R (m), > 0.
+    n_radii : int, default 5
+        Rings including the hub (>= 2).
+    n_azimuth : int, default 12
+        Points per ring (>= 3).
+    return_field : bool, default True
+        Keep the field on the polar grid (``n * n_radii * n_azimuth`` float32 values; 13 MB for 700 s at
+        0.0125 s); with False only the reduced series are kept (memory O(n)).
+
+    Returns
+    -------
+    RotorWind
+
+    Raises
+    ------
+    ValueError
+        An argument is not finite or out of range (the message names it).
+
+    Examples
+    --------
+    >>> w = synthesize_rotor_wind(12.0, 0.17, duration=600.0, dt=0.05, seed=2)
+    >>> w.polar_u.shape, bool(w.rotor_effective.std() < w.hub.std())
+    ((12000, 5, 12), True)
+    >>> bool(0.02 < w.shear_z.mean() < 0.035)
+    True
+    """
+    v = check_number("mean_speed", mean_speed, nonneg=True)
+    ti = _check_ti(turbulence_intensity)
+    duration = check_number("duration", duration, positive=True)
+    dt = check_number("dt", dt, positive=True)
+    alpha = check_number("shear_exponent", shear_exponent, nonneg=True)
+    hub_height = check_number("hub_height", hub_height, positive=True)
+    radius = check_number("radius", radius, positive=True)
+    if radius >= hub_height:
+        raise ValueError(f"radius ({radius} m) must be smaller than hub_height ({hub_height} m)")
+    n_radii = _check_count("n_radii", n_radii, 2)
+    n_azimuth = _check_count("n_azimuth", n_azimuth, 3)
+    if duration < dt:
+        raise ValueError(f"duration ({duration} s) must be at least one sample time dt ({dt} s)")
+    rng = _generator(seed)
+    n_out = int(round(duration / dt))
+    n_fft = next_fast_len(n_out, real=True)
+    t = np.arange(n_out) * dt
+
+    radii = np.arange(n_radii) * radius / (n_radii - 1)
+    psi = np.arange(n_azimuth) * 2.0 * np.pi / n_azimuth
+    # points: the hub, then ring by ring, azimuth fastest
+    y = np.concatenate([[0.0], (radii[1:, None] * np.sin(psi)[None, :]).ravel()])
+    z = np.concatenate([[0.0], (radii[1:, None] * np.cos(psi)[None, :]).ravel()])
+    n_points = y.size
+    u_mean = v * ((hub_height + z) / hub_height) ** alpha
+    # plane-fit rows for the points (the hub point carries the whole central disc)
+    w_ring = _polar_weights(radii, n_azimuth, radius)
+    w_pt = np.concatenate([[w_ring[0] * n_azimuth], np.repeat(w_ring[1:], n_azimuth)])
+    proj = np.stack([w_pt / w_pt.sum(), w_pt * y / np.sum(w_pt * y * y), w_pt * z / np.sum(w_pt * z * z)])
+
+    dist = np.hypot(y[:, None] - y[None, :], z[:, None] - z[None, :])
+    d_min = float(dist[np.triu_indices(n_points, 1)].min())
+    f_coherent = (v * np.log(1.0 / _COHERENCE_FLOOR) / (12.0 * d_min)) if v > 0.0 else 0.0
+    meta = {
+        "mean_speed": v, "turbulence_intensity": ti, "shear_exponent": alpha, "hub_height": hub_height,
+        "radius": radius, "seed": int(seed) if isinstance(seed, int | np.integer) else None, "dt": dt,
+        "n_fft": int(n_fft), "n_points": int(n_points), "coherent_max_hz": float(f_coherent),
+    }
+    polar = np.empty((n_out, n_radii, n_azimuth), dtype=np.float32) if return_field else None
+    reduced = np.zeros((3, n_out))
+    hub = np.full(n_out, u_mean[0])
+
+    turbulent = v > 0.0 and ti > 0.0
+    if turbulent:
+        freqs = np.fft.rfftfreq(n_fft, dt)
+        keep = np.flatnonzero((freqs > 0.0) & (freqs < 0.5 / dt))
+        amp = np.sqrt(2.0 * kaimal_spectrum(freqs[keep], v, ti, hub_height) / (n_fft * dt)) * (0.5 * n_fft)
+        n_low = int(np.searchsorted(freqs[keep], f_coherent, side="right"))
+        low, high = keep[:n_low], keep[n_low:]
+        lc = turbulence_length_scale(hub_height)
+        z_low = np.exp(1j * rng.uniform(0.0, 2.0 * np.pi, (n_points, n_low)))
+        coef_low = np.empty((n_points, n_low), dtype=complex)
+        for start in range(0, n_low, _CHOLESKY_CHUNK):
+            sl = slice(start, min(start + _CHOLESKY_CHUNK, n_low))
+            decay = 12.0 * np.sqrt((freqs[low[sl]] / v) ** 2 + (0.12 / lc) ** 2)
+            coh = np.exp(-decay[:, None, None] * dist[None, :, :])
+            chol = np.linalg.cholesky(coh)  # exponential kernel: positive definite for distinct points
+            coef_low[:, sl] = np.einsum("fjk,kf->jf", chol, z_low[:, sl]) * amp[sl]
+        del z_low
+        amp_high = amp[n_low:]
+        spectrum = np.zeros(freqs.size, dtype=complex)
+    for j in range(n_points):
+        if turbulent:
+            spectrum[low] = coef_low[j]
+            spectrum[high] = amp_high * np.exp(1j * rng.uniform(0.0, 2.0 * np.pi, high.size))
+            # irfft gives (1/N) sum_k X_k e^{2 pi i k m / N} + c.c.; the N/2 in amp makes it sum_k Re(X_k e^{i w_k t})
+            series = irfft(spectrum, n=n_fft)[:n_out] + u_mean[j]
+        else:
+            series = np.full(n_out, u_mean[j])
+        reduced += proj[:, j : j + 1] * series
+        if j == 0:
+            hub = series.copy()
+            if polar is not None:
+                polar[:, 0, :] = series[:, None]
+        elif polar is not None:
+            ring, az = divmod(j - 1, n_azimuth)
+            polar[:, ring + 1, az] = series
+    return RotorWind(t, hub, reduced[0], reduced[1], reduced[2], polar, radii, psi, meta)
