@@ -112,7 +112,10 @@ class SparEnv(gym.Env):
     reward : RewardConfig, optional
     reward_fn : callable, optional
     max_pitch_offset_deg, max_torque_offset, max_pitch_deg, warmup_seconds : float
-        Action scaling (deg, N·m), termination threshold (deg) and warm-up (s).
+        Action scaling (deg, N·m), termination threshold (deg) and warm-up (s). Every argument is checked when
+        the environment is made (finite, sign, range, and the memory a sample step and warm-up imply: at most
+        :data:`MAX_STEP_SAMPLES` samples per forcing chunk, warm-up or control step); a bad one raises a
+        ``ValueError`` naming it. :meth:`step` before :meth:`reset` raises ``gymnasium.error.ResetNeeded``.
 
     Examples
     --------
@@ -145,6 +148,10 @@ class SparEnv(gym.Env):
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}")
+        _check_arguments(dt=dt, control_dt=control_dt, episode_seconds=episode_seconds, noise=noise,
+                         max_pitch_offset_deg=max_pitch_offset_deg, max_torque_offset=max_torque_offset,
+                         max_pitch_deg=max_pitch_deg, warmup_seconds=warmup_seconds, case=case,
+                         reward=reward, reward_fn=reward_fn)
         self.model = model if model is not None else surrogates.FOWTModel()
         if not isinstance(self.model, surrogates.FOWTModel):
             raise ValueError(f"model must be a surrogates.FOWTModel, got {type(self.model).__name__}")
@@ -261,6 +268,9 @@ class SparEnv(gym.Env):
         return self._obs(y, mask), info
 
     def step(self, action):
+        if "truth_all" not in self._last:
+            raise gym.error.ResetNeeded("SparEnv.step() before reset(): call env.reset(seed=...) to start an "
+                                        "episode first")
         act_phys, a = self._physical_action(action)
         noisy, truth = self._sim.advance(self.control_steps, act_phys, noise=self.noise)
         self._step += 1
@@ -322,3 +332,62 @@ class SparEnv(gym.Env):
     def gauge_heights(self) -> np.ndarray:
         """Heights of the nine tower gauges above still water (m)."""
         return np.asarray(GAUGE_HEIGHTS)
+
+
+MAX_STEP_SAMPLES = 2_000_000
+"""Largest number of simulation samples one forcing chunk (600 s), the warm-up or one control step may need
+(a few hundred MB of forcing and output arrays): a ``dt`` of 1e-7 s or a warm-up of 1e7 s is refused up front
+instead of ending in a ``MemoryError`` asking for hundreds of GiB."""
+_CHUNK_SECONDS = 600.0  # surrogates.StreamingSimulator's default forcing chunk
+
+
+def _real(name: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name} must be a real number, got {value!r} ({type(value).__name__})")
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+def _check_arguments(*, dt, control_dt, episode_seconds, noise, max_pitch_offset_deg, max_torque_offset,
+                     max_pitch_deg, warmup_seconds, case, reward, reward_fn) -> None:
+    """Validate SparEnv's constructor arguments: a ValueError naming the first bad one."""
+    step = _real("dt", dt)
+    if step <= 0:
+        raise ValueError(f"dt must be > 0 s, got {dt!r}")
+    if _CHUNK_SECONDS / step > MAX_STEP_SAMPLES:
+        raise ValueError(f"dt={dt!r} s is too small: a {_CHUNK_SECONDS:.0f} s forcing chunk would need "
+                         f"{_CHUNK_SECONDS / step:.3g} samples (at most {MAX_STEP_SAMPLES:.0e}); use dt >= "
+                         f"{_CHUNK_SECONDS / MAX_STEP_SAMPLES:.2g} s")
+    if control_dt is not None:
+        cdt = _real("control_dt", control_dt)
+        if cdt <= 0:
+            raise ValueError(f"control_dt must be > 0 s, got {control_dt!r}")
+        if cdt / step > MAX_STEP_SAMPLES:
+            raise ValueError(f"control_dt={control_dt!r} s is {cdt / step:.3g} samples of dt={dt!r} s per step "
+                             f"(at most {MAX_STEP_SAMPLES:.0e})")
+    if episode_seconds is not None and _real("episode_seconds", episode_seconds) <= 0:
+        raise ValueError(f"episode_seconds must be positive and finite, got {episode_seconds!r}")
+    warm = _real("warmup_seconds", warmup_seconds)
+    if warm < 0:
+        raise ValueError(f"warmup_seconds must be >= 0 s, got {warmup_seconds!r}")
+    if warm / step > MAX_STEP_SAMPLES:
+        raise ValueError(f"warmup_seconds={warmup_seconds!r} s is {warm / step:.3g} samples of dt={dt!r} s (at most "
+                         f"{MAX_STEP_SAMPLES:.0e}, i.e. {MAX_STEP_SAMPLES * step:.4g} s at this dt)")
+    pitch = _real("max_pitch_offset_deg", max_pitch_offset_deg)
+    if not 0.0 <= pitch <= 90.0:
+        raise ValueError(f"max_pitch_offset_deg must be in [0, 90] deg, got {max_pitch_offset_deg!r}")
+    if _real("max_torque_offset", max_torque_offset) < 0:
+        raise ValueError(f"max_torque_offset must be >= 0 N·m, got {max_torque_offset!r}")
+    limit = _real("max_pitch_deg", max_pitch_deg)
+    if not 0.0 < limit <= 180.0:
+        raise ValueError(f"max_pitch_deg must be in (0, 180] deg, got {max_pitch_deg!r}")
+    if not isinstance(noise, (bool, np.bool_)):
+        raise ValueError(f"noise must be True or False, got {noise!r}")
+    if isinstance(case, (bool, np.bool_)) or not isinstance(case, (int, np.integer, surrogates.LoadCase)):
+        raise ValueError(f"case must be a load-case number (int) or a surrogates.LoadCase, got {case!r}")
+    if reward is not None and not isinstance(reward, RewardConfig):
+        raise ValueError(f"reward must be a fowt_env.env.RewardConfig or None, got {type(reward).__name__}")
+    if reward_fn is not None and not callable(reward_fn):
+        raise ValueError(f"reward_fn must be callable (env, truth, action) -> float, or None, got {reward_fn!r}")
