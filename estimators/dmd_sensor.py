@@ -38,7 +38,7 @@ import scipy.linalg as sla
 
 from .hankel_dmd import HankelDMD
 from .screening import FaultScreen, make_screen
-from .validation import apply_masks, as_2d_float, as_records, check_fitted, check_number
+from .validation import MAX_ABS, apply_masks, as_2d_float, as_records, check_fitted, check_number
 
 __all__ = ["HankelDMDSensor"]
 
@@ -186,7 +186,7 @@ class HankelDMDSensor:
             check_number("gate_sigma", self.gate_sigma, positive=True)
         if not isinstance(self.causal, (bool, np.bool_)):
             raise ValueError(f"causal must be True or False, got {self.causal!r}")
-        records = apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=2), mask)
+        records = apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=2, max_abs=MAX_ABS), mask)
         self.screen_ = make_screen(self.screen, records)
         p = records[0].shape[1]
         finite = np.concatenate(records, axis=0)

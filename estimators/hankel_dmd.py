@@ -40,6 +40,7 @@ import scipy.fft as sfft
 import scipy.linalg as sla
 
 from .validation import (
+    MAX_ABS,
     as_2d_float,
     as_records,
     check_fitted,
@@ -413,7 +414,7 @@ class HankelDMD:
         if self.missing not in ("raise", "split"):
             raise ValueError(f"missing must be 'raise' or 'split', got {self.missing!r}")
         split = self.missing == "split"
-        records = as_records(Y, "Y", allow_nan=split, min_samples=1)
+        records = as_records(Y, "Y", allow_nan=split, min_samples=1, max_abs=MAX_ABS)
         dropped = 0
         if split:
             pieces, dropped = split_at_nonfinite(records, d + 2)

@@ -91,7 +91,7 @@ from scipy.signal import lfilter
 from .hankel_dmd import HankelDMD
 from .intervals import calibration_terms, model_error_std, unmeasured_std
 from .screening import FaultScreen, make_screen
-from .validation import NotFittedError, apply_masks, as_records, check_int, check_number, split_at_nonfinite
+from .validation import MAX_ABS, NotFittedError, apply_masks, as_records, check_int, check_number, split_at_nonfinite
 
 __all__ = ["KoopmanKalmanSensor"]
 
@@ -331,7 +331,7 @@ class KoopmanKalmanSensor:
             channel; no complete stretch long enough for the delay window; a rank too large for the data.
         """
         dt, _ = self._check_params()
-        records = apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=1), mask)
+        records = apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=1, max_abs=MAX_ABS), mask)
         self.screen_ = make_screen(self.screen, records)
         p = records[0].shape[1]
         finite = [np.isfinite(r) for r in records]

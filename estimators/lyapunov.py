@@ -46,7 +46,7 @@ from numpy.typing import ArrayLike
 from scipy.interpolate import BSpline
 from scipy.spatial import cKDTree
 
-from .validation import as_2d_float, check_int, check_number, constant_channels
+from .validation import MAX_ABS, as_2d_float, check_int, check_number, constant_channels
 
 __all__ = [
     "LyapunovResult",
@@ -84,7 +84,7 @@ def _as_signal(x: object, name: str = "x", *, min_samples: int = 1, allow_consta
     else:
         raise ValueError(f"{name} must be a 1-D signal (or shape (n_samples, 1)), got shape {shape}")
     try:
-        Y = as_2d_float(arr, name, min_samples=min_samples)
+        Y = as_2d_float(arr, name, min_samples=min_samples, max_abs=MAX_ABS)
     except ValueError as exc:
         raise ValueError(str(exc).replace("channel 0: ", "").replace(" (n_samples, n_channels)", "")) from None
     if not allow_constant and constant_channels(Y).size:

@@ -19,7 +19,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from .hankel_dmd import HankelDMD
-from .validation import as_records, check_int, check_number
+from .validation import MAX_ABS, as_records, check_int, check_number
 
 __all__ = ["ModeShapeDistribution", "mac", "pair_modes", "probabilistic_mode_shapes", "real_mode_shape"]
 
@@ -397,7 +397,7 @@ def probabilistic_mode_shapes(
     hi_pct = check_number("percentiles[1]", percentiles[1], nonneg=True)
     if not lo_pct < hi_pct <= 100:
         raise ValueError(f"percentiles must satisfy 0 <= lower < upper <= 100, got {percentiles!r}")
-    recs = as_records(records, "records", allow_nan=hankel_kwargs.get("missing") == "split")
+    recs = as_records(records, "records", allow_nan=hankel_kwargs.get("missing") == "split", max_abs=MAX_ABS)
     p = recs[0].shape[1]
 
     found: list[list[tuple]] = [[] for _ in targets]

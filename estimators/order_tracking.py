@@ -32,7 +32,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from .hankel_dmd import harmonic_candidates
-from .validation import as_2d_float, check_number
+from .validation import MAX_ABS, as_2d_float, check_number
 
 __all__ = ["AngleDomainData", "resample_to_azimuth", "rotor_azimuth", "rotor_harmonics"]
 
@@ -161,7 +161,7 @@ def resample_to_azimuth(
         ``azimuth``.
     """
     dt = check_number("dt", dt, positive=True)
-    Y = as_2d_float(Y, "Y", min_samples=4)
+    Y = as_2d_float(Y, "Y", min_samples=4, max_abs=MAX_ABS)
     psi, speed = _azimuth_input(Y.shape[0], dt, rotor_speed, azimuth)
     n = Y.shape[0]
     grid = np.linspace(psi[0], psi[-1], n)
@@ -184,12 +184,20 @@ def rotor_harmonics(
     harmonic_damping: float = 0.01,
     min_phase_locking: float = 0.8,
     freq_rtol: float = 0.01,
+    components: int | None = 8,
 ) -> list[dict]:
     """Rotor-locked harmonics of a record: Hankel-DMD lines in the order domain.
 
     Resamples ``Y`` at equal azimuth steps (:func:`resample_to_azimuth`) and keeps the lines
     :func:`~estimators.hankel_dmd.harmonic_candidates` finds there: labelled ``"harmonic"`` (undamped and
     phase-locked, see :meth:`~estimators.HankelDMD.mode_table`) at every delay depth, at the same order.
+
+    With more than ``components`` channels, the resampled data are first projected on their leading
+    ``components`` principal components (unscaled, so each keeps its share of the variance). A rotor harmonic is
+    common to the channels and lives in the leading components; the Hankel matrices then have
+    ``components x delay`` rows instead of ``n_channels x delay``, and the cost grows with the record's length
+    instead of with the cube of ``n_channels x delay`` (36 tower channels at 60 delays: a 2160-square Gram
+    matrix per delay depth).
 
     Parameters
     ----------
@@ -205,6 +213,8 @@ def rotor_harmonics(
         Hankel-DMD rank.
     harmonic_damping, min_phase_locking, freq_rtol : float
         Passed to :func:`harmonic_candidates`.
+    components : int or None
+        Principal components kept (default 8); None keeps every channel.
 
     Returns
     -------
@@ -231,8 +241,17 @@ def rotor_harmonics(
     ang = resample_to_azimuth(Y, dt, rotor_speed=rotor_speed, azimuth=azimuth)
     f1 = ang.rotor_frequency_hz
     lo, hi = ang.speed_percentiles_hz
+    y = ang.y
+    if components is not None:
+        k = int(components)
+        if k < 1:
+            raise ValueError(f"components must be a positive integer or None, got {components!r}")
+        if k < y.shape[1]:
+            yc = y - y.mean(axis=0)
+            _, vecs = np.linalg.eigh(yc.T @ yc)  # ascending: the last k are the leading components
+            y = yc @ vecs[:, ::-1][:, :k]
     rows = []
-    for line in harmonic_candidates(ang.y, ang.dt, delays, rank, harmonic_damping=harmonic_damping,
+    for line in harmonic_candidates(y, ang.dt, delays, rank, harmonic_damping=harmonic_damping,
                                     min_phase_locking=min_phase_locking, freq_rtol=freq_rtol):
         order = line["frequency_hz"] / f1
         rows.append({

@@ -13,6 +13,7 @@ import numpy as np
 from scipy import signal
 
 from .validation import (
+    MAX_ABS,
     as_2d_float,
     as_records,
     check_fitted,
@@ -138,7 +139,7 @@ def preprocess(
     >>> np.allclose(Z.mean(axis=0), 0.0), np.allclose(Z.std(axis=0), 1.0)
     (True, True)
     """
-    Y = as_2d_float(Y, "Y", min_samples=2)
+    Y = as_2d_float(Y, "Y", min_samples=2, max_abs=MAX_ABS)
     check_no_constant_channels(Y, "Y")
     sos = band_sos(fs, band, order)
     F = _zero_phase(sos, Y, "Y")
@@ -225,7 +226,7 @@ class Preprocessor:
         self
         """
         self.sos_ = band_sos(self.fs, self.band, self.order)
-        records = as_records(Y, "Y", min_samples=2)
+        records = as_records(Y, "Y", min_samples=2, max_abs=MAX_ABS)
         for i, rec in enumerate(records):
             check_no_constant_channels(rec, "Y" if len(records) == 1 else f"Y[{i}]")
         F = np.concatenate([self._filter(rec, "Y") for rec in records], axis=0)
@@ -246,7 +247,7 @@ class Preprocessor:
         ndarray (n_samples, n_channels) or list of them (dimensionless)
         """
         check_fitted(self, "mean_")
-        records = as_records(Y, "Y", min_samples=1, n_channels=self.n_channels_)
+        records = as_records(Y, "Y", min_samples=1, n_channels=self.n_channels_, max_abs=MAX_ABS)
         out = [(self._filter(rec, "Y") - self.mean_) / self.std_ for rec in records]
         return out if is_record_list(Y) else out[0]
 

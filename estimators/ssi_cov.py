@@ -39,6 +39,7 @@ import scipy.linalg as sla
 from scipy.cluster.hierarchy import fcluster, linkage
 
 from .validation import (
+    MAX_ABS,
     as_records,
     check_fitted,
     check_int,
@@ -398,7 +399,7 @@ class SSICov:
         if self.missing not in ("raise", "split"):
             raise ValueError(f"missing must be 'raise' or 'split', got {self.missing!r}")
         split = self.missing == "split"
-        records = as_records(Y, "Y", allow_nan=split, min_samples=1)
+        records = as_records(Y, "Y", allow_nan=split, min_samples=1, max_abs=MAX_ABS)
         need = step * (2 * i - 1) + 1  # the largest lag plus one
         dropped = 0
         if split:

@@ -12,6 +12,7 @@ from numbers import Integral, Real
 import numpy as np
 
 __all__ = [
+    "MAX_ABS",
     "NotFittedError",
     "apply_masks",
     "as_2d_float",
@@ -28,6 +29,12 @@ __all__ = [
 ]
 
 _MAX_LISTED = 5
+
+MAX_ABS = 1e150
+"""Largest magnitude the estimators fit on: squares and sums of squares of larger values overflow float64 (a
+variance of 1e300-sized data is inf, a z-score 0), so training and identification data beyond it get a clear
+error naming the channel instead of a silent wrong result (all-zero preprocessing, a NaN rank). Streaming
+``update``/``reconstruct`` accept any finite value: their fault screen rejects wild samples."""
 
 
 class NotFittedError(ValueError, AttributeError):
@@ -74,6 +81,7 @@ def as_2d_float(
     allow_nan: bool = False,
     min_samples: int = 1,
     n_channels: int | None = None,
+    max_abs: float | None = None,
 ) -> np.ndarray:
     """Return ``Y`` as a C-contiguous float64 array of shape ``(n_samples, n_channels)`` after checking it.
 
@@ -89,6 +97,8 @@ def as_2d_float(
         Minimum number of rows.
     n_channels : int, optional
         Required number of columns (e.g. the number seen in ``fit``).
+    max_abs : float, optional
+        Refuse finite values larger in magnitude (:data:`MAX_ABS` for data that statistics are computed on).
 
     Returns
     -------
@@ -135,6 +145,12 @@ def as_2d_float(
         if msg:
             what = "finite (no ±inf)" if allow_nan else "finite"
             raise ValueError(f"{name} must be {what}: {msg}")
+    if max_abs is not None and arr.size:
+        peak = np.nanmax(np.abs(arr), axis=0, initial=0.0)
+        if np.any(peak > max_abs):
+            c = int(np.argmax(peak > max_abs))
+            raise ValueError(f"{name} channel {c} reaches {peak[c]:.3g} in magnitude, beyond {max_abs:.0e} where its "
+                             "statistics overflow float64; rescale the data (other units) first")
     return arr
 
 
@@ -155,6 +171,7 @@ def as_records(
     allow_nan: bool = False,
     min_samples: int = 1,
     n_channels: int | None = None,
+    max_abs: float | None = None,
 ) -> list[np.ndarray]:
     """One 2-D array or a list of them (separate records) -> list of checked float64 arrays.
 
@@ -173,10 +190,12 @@ def as_records(
     if isinstance(Y, (list, tuple)) and len(Y) == 0:
         raise ValueError(f"{name} must be a 2-D array or a non-empty list of records, got an empty list")
     if not is_record_list(Y):
-        return [as_2d_float(Y, name, allow_nan=allow_nan, min_samples=min_samples, n_channels=n_channels)]
+        return [as_2d_float(Y, name, allow_nan=allow_nan, min_samples=min_samples, n_channels=n_channels,
+                            max_abs=max_abs)]
     records = []
     for i, y in enumerate(Y):
-        rec = as_2d_float(y, f"{name}[{i}]", allow_nan=allow_nan, min_samples=min_samples, n_channels=n_channels)
+        rec = as_2d_float(y, f"{name}[{i}]", allow_nan=allow_nan, min_samples=min_samples, n_channels=n_channels,
+                          max_abs=max_abs)
         n_channels = rec.shape[1]
         records.append(rec)
     return records
