@@ -54,6 +54,7 @@ from scipy.signal import lfilter
 
 from .intervals import calibration_terms, model_error_std, unmeasured_std
 from .screening import FaultScreen, make_screen
+from .validation import MAX_ABS, as_2d_float
 
 __all__ = ["KalmanSensor"]
 
@@ -1122,10 +1123,15 @@ def _as_records(Y, mask, n_ch: int) -> list[np.ndarray]:
         ys, masks = [Y], [mask]
     out = []
     for i, (yi, mi) in enumerate(zip(ys, masks, strict=True)):
+        # the one input contract of every estimator: real numbers, NaN = missing, no ±inf, statistics finite
+        name = "Y" if len(ys) == 1 else f"Y[{i}]"
         try:
-            yi = np.array(yi, dtype=float)
-        except (TypeError, ValueError):
-            raise ValueError(f"Y: record {i} is not a numeric array") from None
+            yi = as_2d_float(yi, name, allow_nan=True, max_abs=MAX_ABS).copy()
+        except ValueError as exc:
+            if "must be 2-D" in str(exc) or "at least one channel" in str(exc):
+                raise ValueError(f"Y: record {i} must have shape (n_samples, {n_ch}) (one column per model "
+                                 f"output), got {np.shape(yi)}") from None
+            raise
         if yi.ndim != 2 or yi.shape[1] != n_ch:
             raise ValueError(
                 f"Y: record {i} must have shape (n_samples, {n_ch}) (one column per model output), got {yi.shape}"

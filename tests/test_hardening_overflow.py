@@ -54,3 +54,20 @@ def test_overflow_limit_is_scale_free_inside(y):
     big = preprocess(y * 1e140, fs=1 / DT)
     assert np.any(ref != 0.0)
     np.testing.assert_allclose(big, ref, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize(("edit", "message"), [
+    (lambda Y: Y.astype(complex) + 1j, "must be real"),
+    (lambda Y: np.where(np.arange(Y.shape[0])[:, None] == 7, np.inf, Y), r"must be finite \(no ±inf\): channel 0"),
+    (lambda Y: Y * 1e300, "beyond 1e\\+150"),
+])
+def test_one_input_contract_for_every_estimator_fit(y, edit, message):
+    """KalmanSensor.fit dropped the imaginary part of complex input and took ±inf that the others refuse."""
+    from estimators import KalmanSensor
+
+    bad = edit(y)
+    for fit in (lambda Y: KalmanSensor(two_dof_system(), dt=DT, em_iter=0).fit(Y),
+                lambda Y: KoopmanKalmanSensor(delays=20, rank=8, dt=DT, em_iter=0).fit(Y),
+                lambda Y: HankelDMDSensor(delays=20, rank=8, dt=DT).fit(Y)):
+        with pytest.raises(ValueError, match=message):
+            fit(bad)
