@@ -41,6 +41,7 @@ from scipy.optimize import linear_sum_assignment
 from .aero import OperatingPoint, operating_point
 from .channels import ALL_CHANNELS, GAUGE_HEIGHTS, UNITS, tower_channels
 from .controller import DISCON
+from .drag import DragStrips, drag_strips, wave_velocity_rao, with_relative_velocity_std
 from .effects import resolve_effects
 from .load_cases import LoadCase, load_case
 from .oc3 import GRAVITY
@@ -212,6 +213,8 @@ class LinearSystem:
     rotor_speed: float  # rad/s mean
     effects: dict[str, float]
     structure: Structure = field(repr=False)
+    drag: DragStrips | None = field(default=None, repr=False)
+    """The Morison drag strips with the equivalent linearisation held in ``A`` (and in the wave forcing)."""
 
     def equilibrium(self, nonlinear_force=None, tol: float = 1e-10) -> np.ndarray:
         """Static equilibrium state under the mean loads (and an optional ``nonlinear_force(x) -> (10,)``)."""
@@ -416,7 +419,8 @@ class FOWTModel:
         f_u[:, hub.start + 3:hub.stop] += r_tt.T
         f_u[:, INPUT_BLOCKS["nonlinear"]] += np.eye(N_DOF)
         # rotor asymmetry: hub loads per unit disc gradient of the wind, (force, moment) per column
-        shear_loads = _shear_hub_loads(op, st.data.tip_radius, eff["rotor_asymmetry"])
+        # (the simulation's nonlinear rotor samples the turbulent field blade by blade instead)
+        shear_loads = _shear_hub_loads(op, st.data.tip_radius, 0.0 if nonlinear_rotor else eff["rotor_asymmetry"])
         sh = INPUT_BLOCKS["shear"]
         for col, (force, moment) in zip(range(sh.start, sh.stop), shear_loads, strict=True):
             f_u[:, col] += j_hub.T @ force + r_tt.T @ moment
@@ -443,6 +447,16 @@ class FOWTModel:
             a[2 * N_DOF] = (qa_x - qg_x) / j
             b[2 * N_DOF] = (qa_u - qg_u) / j
             a[2 * N_DOF + 1, 2 * N_DOF] = 1.0
+
+        # the Morison drag's equivalent linearisation about this load case's stationary response (sea state and
+        # turbulence), solved by iteration on the linear model's own relative velocity (as RAFT does)
+        drag = drag_strips()
+        if lc is not None and (lc.hs > 0 or (lc.wind_speed > 0 and lc.turbulence_intensity > 0)):
+            if nonlinear_rotor:  # the same linearisation as the linear-rotor model of this case
+                drag = self._system(lc, nonlinear_rotor=False).drag
+            else:
+                drag = _stochastic_drag(a, b, minv, lc, drag, op)
+            a[N_DOF:2 * N_DOF, N_DOF:N_DOF + 6] -= minv[:, :6] @ drag.platform_damping()
 
         # ------------------------------------------------------------------ outputs (55 channels)
         qdd_x, qdd_u = a[N_DOF:2 * N_DOF], b[N_DOF:2 * N_DOF]
@@ -553,7 +567,7 @@ class FOWTModel:
         rows_x["RotThrust"], rows_u["RotThrust"] = rot_x / 1e3, rot_u / 1e3
         cmat = np.array([rows_x[ch] for ch in ALL_CHANNELS])
         dmat = np.array([rows_u[ch] for ch in ALL_CHANNELS])
-        return LinearSystem(a, b, cmat, dmat, tuple(ALL_CHANNELS), op, omega0, dict(eff), st)
+        return LinearSystem(a, b, cmat, dmat, tuple(ALL_CHANNELS), op, omega0, dict(eff), st, drag)
 
     # ----------------------------------------------------------------------------------------- analysis
     def modal_analysis(self, case: int | LoadCase | None = None) -> ModalResult:
@@ -658,6 +672,22 @@ TOWER_AERO = {"cd": 1.0, "diameter_base": 6.5, "diameter_top": 3.87, "shear_expo
 instantaneous hub-height wind."""
 
 
+BLADE_SAMPLING_RADIUS = 0.75
+"""Radius of the blade-effective wind (fraction of R): the field averaged along the blade with weights
+proportional to the radius over the rings at R/4, R/2, 3R/4 and R."""
+
+
+def blade_load_radii(radius: float) -> tuple[float, float]:
+    """Effective radii (m) of a blade's thrust (for the rotor moments) and of its in-plane force (torque / r)
+    in the rotationally sampled rotor model, chosen so that under a linear wind gradient it gives exactly the
+    calibrated gradient model of :data:`ROTOR_ASYMMETRY` (tilt ``= moment dT/dU R^2 dU/dz``: ``r_s r_T / 2 =
+    moment R^2``; side force ``= -side_force dQ/dU dU/dz``: ``r_s / (2 r_Q) = side_force``)."""
+    r_s = BLADE_SAMPLING_RADIUS * radius
+    r_t = 2.0 * ROTOR_ASYMMETRY["moment"] * radius**2 / r_s
+    r_q = r_s / (2.0 * ROTOR_ASYMMETRY["side_force"])
+    return r_t, r_q
+
+
 def _shear_hub_loads(op: OperatingPoint | None, radius: float, strength: float):
     """(force, moment) at the hub per unit dU/dy and per unit dU/dz (N·s, N·m·s), global axes."""
     zero = (np.zeros(3), np.zeros(3))
@@ -681,6 +711,64 @@ def _tower_drag_strips(z0: float, z1: float, strength: float, n: int = 40):
     diam = ta["diameter_base"] + (ta["diameter_top"] - ta["diameter_base"]) * (z - z0) / (z1 - z0)
     profile = (z / ta["hub_height"]) ** (2 * ta["shear_exponent"])
     return z, strength * 0.5 * RHO_AIR * ta["cd"] * diam * dz * profile
+
+
+def _stochastic_drag(a0: np.ndarray, b: np.ndarray, minv: np.ndarray, lc: LoadCase, strips: DragStrips,
+                     op: OperatingPoint | None, iterations: int = 30) -> DragStrips:
+    """Equivalent linear drag about the stationary response: iterate ``sigma_r`` (std of the relative velocity
+    along the wave direction at each strip, waves and rotor-effective turbulence) and the linear model."""
+    from .waves import excitation_rao, jonswap_spectrum
+    from .wind import kaimal_spectrum, rotor_averaging
+
+    f = np.linspace(0.002, 0.6, 600)
+    df = f[1] - f[0]
+    w = 2 * np.pi * f
+    n = a0.shape[0]
+    z = strips.z
+    e = strips.direction
+    tmat = np.zeros((z.size, 6))  # strip velocity along e per platform velocity
+    tmat[:, 0], tmat[:, 4] = e[0], e[0] * z
+    tmat[:, 1], tmat[:, 3] = e[1], -e[1] * z
+    s_eta = jonswap_spectrum(f, lc.hs, lc.tp, lc.gamma) if lc.hs > 0 else np.zeros_like(f)
+    u_w = wave_velocity_rao(z, f)  # along e, per m of amplitude
+    x_rao = excitation_rao(f, lc.wave_dir_deg) if lc.hs > 0 else np.zeros((f.size, 6), complex)
+    wave_cols = INPUT_BLOCKS["wave"]
+    b_wave = b[:, wave_cols]
+    b_wind = b[:, INPUT_BLOCKS["wind"].start]
+    turbulent = op is not None and lc.turbulence_intensity > 0 and np.any(b_wind)
+    if turbulent:
+        h2, _ = rotor_averaging(f, lc.wind_speed)
+        s_wind = kaimal_spectrum(f, lc.wind_speed, lc.turbulence_intensity) * h2
+    sigma = np.sqrt(np.maximum(np.sum(np.abs(u_w) ** 2 * s_eta[:, None], axis=0) * df, 0.0))
+    current = with_relative_velocity_std(strips, sigma)
+    for _ in range(iterations):
+        a = a0.copy()
+        a[N_DOF:2 * N_DOF, N_DOF:N_DOF + 6] -= minv[:, :6] @ current.platform_damping()
+        mats = current.strip_matrices()
+        # generalised drag excitation per unit amplitude: sum_j T_j^T D_j e u_w,j
+        fd = np.zeros((f.size, 6), complex)
+        dv = np.einsum("sij,j->si", mats, e)  # (strips, 2) force per unit along-velocity
+        fd[:, 0] = u_w @ dv[:, 0]
+        fd[:, 1] = u_w @ dv[:, 1]
+        fd[:, 3] = -(u_w * z) @ dv[:, 1]
+        fd[:, 4] = (u_w * z) @ dv[:, 0]
+        var = np.zeros(z.size)
+        for i, wi in enumerate(w):
+            lhs = 1j * wi * np.eye(n) - a
+            if lc.hs > 0 and s_eta[i] > 0:
+                xw = np.linalg.solve(lhs, b_wave @ (x_rao[i] + fd[i]))
+                rel = u_w[i] - tmat @ xw[N_DOF:N_DOF + 6]
+                var += np.abs(rel) ** 2 * s_eta[i] * df
+            if turbulent:
+                xv = np.linalg.solve(lhs, b_wind)
+                var += np.abs(tmat @ xv[N_DOF:N_DOF + 6]) ** 2 * s_wind[i] * df
+        new_sigma = np.sqrt(var)
+        done = np.max(np.abs(new_sigma - sigma)) < 1e-3 * (np.max(sigma) + 1e-9)
+        sigma = 0.5 * (sigma + new_sigma)
+        current = with_relative_velocity_std(strips, sigma)
+        if done:
+            break
+    return current
 
 
 def _tower_labels(labels: list[str], freqs: np.ndarray) -> list[str]:

@@ -28,15 +28,16 @@ from .aero import rotor_coefficients, rotor_table
 from .channels import ALL_CHANNELS, UNITS
 from .controller import DISCON, N_CONTROLLER_STATE, discon_step, initial_controller_state
 from .controller import PARAMS as DISCON_PARAMS
+from .drag import N_STRIPS, drag_strips
 from .load_cases import LoadCase
-from .model import INPUT_BLOCKS, N_INPUT, N_STATE, FOWTModel, LinearSystem, _as_case
+from .model import INPUT_BLOCKS, N_INPUT, N_STATE, FOWTModel, LinearSystem, _as_case, blade_load_radii
 from .mooring import mooring_loads, mooring_table
-from .oc3 import RHO_AIR, RHO_WATER
+from .oc3 import RHO_AIR
 from .record import Record
 from .structure import N_DOF
 from .validation import check_number
-from .waves import SparGeometry, synthesize_waves
-from .wind import synthesize_wind
+from .waves import synthesize_waves
+from .wind import synthesize_rotor_wind
 
 
 def mean_shear_z(wind_speed: float, exponent: float = 0.2, hub_height: float = 90.0, radius: float = 63.0) -> float:
@@ -57,16 +58,19 @@ MAX_INTERNAL_STEP = 0.025
 MAX_SAMPLE_TIME = 0.15
 """Largest sample time (s): the 2nd tower modes (up to ~2.6 Hz) must lie below the Nyquist frequency."""
 N_EX = INPUT_BLOCKS["shear"].stop  # exogenous (precomputed) inputs: const, wave(6), wind, elev, hub wind, shear(2)
-N_STRIPS = 24
 _PLATFORM_DOF = {"PtfmSurge": 0, "PtfmSway": 1, "PtfmHeave": 2, "PtfmRoll": 3, "PtfmPitch": 4, "PtfmYaw": 5}
 _INITIAL_CHANNELS = (*_PLATFORM_DOF, "TTDspFA", "TTDspSS", "RotSpeed")
 
 
 # ------------------------------------------------------------------------------------------------ kernel
 # scalar parameters of the kernel, packed in one float array ``par``
-P_DT, P_SMOOR, P_ZF, P_UNUSED, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
-    P_JREACT, P_GENEFF = range(15)
-N_PAR = 15
+P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
+    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_RQ = range(20)
+N_PAR = 20
+FIELD_DT = 0.05
+"""Time step (s) of the synthesised turbulent field over the rotor disc."""
+N_BLADE_AZIMUTH = 24
+"""Azimuths of the blade-effective wind around the rotor (-)."""
 I_WIND = INPUT_BLOCKS["wind"].start
 I_HUB_WIND = INPUT_BLOCKS["hub_wind"].start
 I_ACTION = INPUT_BLOCKS["action"].start
@@ -93,7 +97,8 @@ def _mooring_generalised(x, gx, gy, gyaw, tab, zf, out):
 
 
 @numba.njit(cache=True, nogil=True)
-def _loads(x, ctrl, k, psi, action, u_ex, vel, strip_z, drag_coef, moor_gx, moor_gy, moor_gyaw, moor_tab, moor_g0,
+def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_along, drag_across, drag_dir, moor_gx,
+           moor_gy, moor_gyaw, moor_tab, moor_g0,
            moor_jac, moor_out, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab, cq_tab, par, u):
     """Fill u[10:] (actions, hub loads, nonlinear generalised forces, rotor outputs) from the state at the start
     of a step; return the rotor acceleration (rad/s^2, 0 when the rotor is linear or parked)."""
@@ -107,8 +112,11 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, strip_z, drag_coef, moor_gx, moor
     u[I_ACTION + 1] = action[1]
     v_hub_wind = u_ex[k, I_HUB_WIND]
     u[rot0 + 4] = v_hub_wind * abs(v_hub_wind)
-    # --- quadratic drag on the relative velocity, strip by strip
-    if drag_coef.shape[0] > 0:
+    # --- quadratic drag on the relative velocity, strip by strip, minus its equivalent linearisation (which the
+    #     linear model holds)
+    s_drag = par[P_SDRAG]
+    if s_drag > 0.0:
+        ex, ey = drag_dir[0], drag_dir[1]
         for j in range(strip_z.shape[0]):
             z = strip_z[j]
             vx = x[nd + 0] + z * x[nd + 4]
@@ -116,8 +124,11 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, strip_z, drag_coef, moor_gx, moor
             ux = vel[k, j, 0] - vx
             uy = vel[k, j, 1] - vy
             s = math.sqrt(ux * ux + uy * uy)
-            fx = drag_coef[j] * s * ux
-            fy = drag_coef[j] * s * uy
+            ua = ux * ex + uy * ey
+            lx = drag_along[j] * ua * ex + drag_across[j] * (ux - ua * ex)
+            ly = drag_along[j] * ua * ey + drag_across[j] * (uy - ua * ey)
+            fx = s_drag * (drag_coef[j] * s * ux - lx)
+            fy = s_drag * (drag_coef[j] * s * uy - ly)
             u[nl0 + 0] += fx
             u[nl0 + 1] += fy
             u[nl0 + 3] += -z * fy
@@ -149,6 +160,39 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, strip_z, drag_coef, moor_gx, moor
         qdyn = par[P_QAREA] * vn * abs(vn)
         thrust = qdyn * ct
         q_aero = qdyn * par[P_RADIUS] * cq
+        # rotationally sampled turbulence: each blade's wind departs from the disc mean; linear blade loads give
+        # the rotor's tilt/yaw moments, in-plane force and the 3P-band thrust and torque
+        s_asym = par[P_SASYM]
+        if s_asym > 0.0 and blade.shape[0] > k:
+            n_az = blade.shape[1]
+            d_az = 2.0 * math.pi / n_az
+            mt = 0.0
+            my = 0.0
+            fy = 0.0
+            fz = 0.0
+            for b in range(3):
+                psi_b = psi + b * 2.0 * math.pi / 3.0
+                phi = (-psi_b) % (2.0 * math.pi)  # the blade's azimuth from the top towards +y
+                fa = phi / d_az
+                i0 = int(fa) % n_az
+                i1 = (i0 + 1) % n_az
+                wa = fa - int(fa)
+                v_b = (1.0 - wa) * blade[k, i0] + wa * blade[k, i1]
+                dv = s_asym * (v_b - wind)
+                d_t = par[P_DTDU] / 3.0 * dv
+                d_q = par[P_DQDU] / 3.0 * dv
+                thrust += d_t
+                q_aero += d_q
+                c_b = math.cos(psi_b)
+                s_b = math.sin(psi_b)
+                mt += d_t * par[P_RT] * c_b  # blade at (y, z) = r (-sin, cos): tilt = z F
+                my += d_t * par[P_RT] * s_b  # yaw = -y F
+                fy += -d_q / par[P_RQ] * c_b  # in-plane force along the direction of rotation
+                fz += -d_q / par[P_RQ] * s_b
+            u[hub0 + 1] += fy
+            u[hub0 + 2] += fz
+            u[hub0 + 4] += mt
+            u[hub0 + 5] += my
         q_gen_hss = ctrl[3] + action[1] / par[P_NGEAR]
         q_gen = par[P_NGEAR] * q_gen_hss
         domega = (q_aero - q_gen) / par[P_J]
@@ -182,7 +226,9 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, strip_z, drag_coef, moor_gx, moor
 
 
 @numba.njit(cache=True, nogil=True)
-def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, vel, strip_z, drag_coef, moor_gx,
+def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, vel, blade, strip_z, drag_coef,
+             drag_along,
+             drag_across, drag_dir, moor_gx,
              moor_gy, moor_gyaw, moor_tab, moor_g0, moor_jac, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab,
              cq_tab, discon, par, x_hist, u_hist, out0):
     """Advance ``n_steps`` internal steps from step index ``k0``.
@@ -203,7 +249,9 @@ def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, v
     moor_out = np.zeros(12)
     for step in range(n_steps):
         k = k0 + step
-        domega = _loads(x, ctrl, k, psi, action, u_ex, vel, strip_z, drag_coef, moor_gx, moor_gy, moor_gyaw,
+        domega = _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_along, drag_across,
+                        drag_dir,
+                        moor_gx, moor_gy, moor_gyaw,
                         moor_tab, moor_g0, moor_jac, moor_out, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab,
                         cq_tab, par, u)
         if step % every == 0:
@@ -294,12 +342,10 @@ class Simulator:
         self.cy = np.ascontiguousarray(self.system.C)
         self.dy = np.ascontiguousarray(self.system.D)
         st = self.system.structure
-        geo = SparGeometry()
-        z, dz, diam = geo.strips(N_STRIPS)
-        self.strip_z = np.ascontiguousarray(z, dtype=float)
-        s_drag = eff["quadratic_drag"]
-        self.drag_coef = (0.5 * RHO_WATER * geo.cd * np.asarray(diam) * np.asarray(dz) * s_drag
-                          if s_drag > 0 else np.zeros(0))
+        self.drag = self.system.drag if self.system.drag is not None else drag_strips()
+        self.strip_z = np.ascontiguousarray(self.drag.z, dtype=float)
+        self.drag_arrays = tuple(np.ascontiguousarray(a, dtype=float) for a in (
+            self.drag.coef, self.drag.along, self.drag.across, self.drag.direction))
         tab = mooring_table()
         self.moor_grids = tuple(np.ascontiguousarray(g, dtype=float) for g in (tab.grid_dx, tab.grid_dy, tab.grid_yaw))
         self.moor_tab = np.ascontiguousarray(tab.table, dtype=float)
@@ -323,6 +369,7 @@ class Simulator:
         par = np.zeros(N_PAR)
         par[P_DT] = self.dt_int
         par[P_SMOOR] = float(eff["mooring_nonlinear"])
+        par[P_SDRAG] = float(eff["quadratic_drag"])
         par[P_ZF] = zf
         par[P_ROTOR] = 1.0 if self.nonlinear_rotor else 0.0
         par[P_V0] = self.case.wind_speed if self.case is not None else 0.0
@@ -335,6 +382,10 @@ class Simulator:
         par[P_TILT] = d.shaft_tilt_rad
         par[P_JREACT] = d.gearbox_ratio * (d.gearbox_ratio - 1.0) * d.generator_inertia
         par[P_GENEFF] = DISCON["GenEff"]
+        if op is not None and self.nonlinear_rotor:
+            par[P_SASYM] = float(eff["rotor_asymmetry"])
+            par[P_DTDU], par[P_DQDU] = op.dT_dV, op.dQ_dV
+            par[P_RT], par[P_RQ] = blade_load_radii(rt.radius)
         self.par = par
         self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
         if op is not None:
@@ -369,10 +420,13 @@ class Simulator:
         return g0, np.ascontiguousarray(-jac)
 
     def loads(self, x: np.ndarray, k: int, psi: float, action: np.ndarray, u_ex: np.ndarray, vel: np.ndarray,
-              ctrl: np.ndarray) -> tuple[np.ndarray, float]:
+              ctrl: np.ndarray, blade: np.ndarray | None = None) -> tuple[np.ndarray, float]:
         """Per-step inputs ``u`` (N_INPUT,) and rotor acceleration at state ``x`` and forcing sample ``k``."""
         u = np.zeros(N_INPUT)
-        domega = _loads(x, ctrl, k, psi, np.asarray(action, float), u_ex, vel, self.strip_z, self.drag_coef,
+        if blade is None:
+            blade = np.zeros((0, N_BLADE_AZIMUTH), dtype=np.float32)
+        domega = _loads(x, ctrl, k, psi, np.asarray(action, float), u_ex, vel, blade, self.strip_z,
+                        *self.drag_arrays,
                         *self.moor_grids, self.moor_tab, self.moor_g0, self.moor_jac, np.zeros(12), self.harm,
                         self.e_s, self.h_v, self.r_pitch, *self.rotor_grids, self.par, u)
         return u, domega
@@ -433,16 +487,20 @@ class Simulator:
         return x, ctrl
 
     def advance(self, x: np.ndarray, ctrl: np.ndarray, psi: float, k0: int, n_steps: int, every: int,
-                exo: np.ndarray, u_ex: np.ndarray, action: np.ndarray, vel: np.ndarray, x_hist: np.ndarray,
-                u_hist: np.ndarray, out0: int) -> float:
+                exo: np.ndarray, u_ex: np.ndarray, action: np.ndarray, vel: np.ndarray, blade: np.ndarray,
+                x_hist: np.ndarray, u_hist: np.ndarray, out0: int) -> float:
         """Run the compiled stepper (``x`` and ``ctrl`` in place); returns the new rotor azimuth (rad)."""
-        return _advance(x, ctrl, psi, k0, n_steps, every, self.phi, self.g_rest, exo, u_ex, action, vel,
-                        self.strip_z, self.drag_coef, *self.moor_grids, self.moor_tab, self.moor_g0, self.moor_jac,
+        return _advance(x, ctrl, psi, k0, n_steps, every, self.phi, self.g_rest, exo, u_ex, action, vel, blade,
+                        self.strip_z, *self.drag_arrays, *self.moor_grids, self.moor_tab, self.moor_g0, self.moor_jac,
                         self.harm, self.e_s, self.h_v, self.r_pitch, *self.rotor_grids, self.discon, self.par,
                         x_hist, u_hist, out0)
 
-    def forcing(self, n_steps: int, seed_sequence: np.random.SeedSequence) -> tuple[np.ndarray, np.ndarray, float]:
-        """Exogenous inputs for ``n_steps`` internal steps (+1 sample for the hold), strip velocities, azimuth."""
+    def forcing(self, n_steps: int, seed_sequence: np.random.SeedSequence
+                ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
+        """Exogenous inputs for ``n_steps`` internal steps (+1 sample for the hold), strip velocities, initial
+        rotor azimuth, and the blade-effective wind around the rotor (``(n, n_azimuth)`` float32: the turbulent
+        field over the disc averaged along a blade with weights proportional to the radius, at azimuths
+        measured from the top towards +y; empty without turbulent wind)."""
         wave_ss, wind_ss, psi_ss = seed_sequence.spawn(3)
         n = n_steps + 1
         duration = n * self.dt_int
@@ -453,17 +511,30 @@ class Simulator:
         if lc is not None and lc.hs > 0:
             w = synthesize_waves(lc.hs, lc.tp, lc.gamma, lc.wave_dir_deg, duration, self.dt_int,
                                  seed=int(wave_ss.generate_state(1)[0]), n_strips=N_STRIPS)
-            u_ex[:, INPUT_BLOCKS["wave"]] = w.excitation[:n]
+            u_ex[:, INPUT_BLOCKS["wave"]] = w.excitation[:n] + self.drag.excitation(w.velocity[:n])
             u_ex[:, INPUT_BLOCKS["elev"].start] = w.elevation[:n]
             vel = np.ascontiguousarray(w.velocity[:n])
+        blade = np.zeros((0, N_BLADE_AZIMUTH), dtype=np.float32)
         if lc is not None and lc.wind_speed > 0:
-            wd = synthesize_wind(lc.wind_speed, lc.turbulence_intensity, duration, self.dt_int,
-                                 seed=int(wind_ss.generate_state(1)[0]))
-            u_ex[:, INPUT_BLOCKS["wind"].start] = wd.rotor_effective[:n] - lc.wind_speed
-            u_ex[:, INPUT_BLOCKS["hub_wind"].start] = wd.hub[:n]
-            u_ex[:, INPUT_BLOCKS["shear"].start + 1] = mean_shear_z(lc.wind_speed)
+            # the field at FIELD_DT (its content above ~2 Hz is negligible), interpolated to the internal step
+            wd = synthesize_rotor_wind(lc.wind_speed, lc.turbulence_intensity, duration + 2 * FIELD_DT, FIELD_DT,
+                                       seed=int(wind_ss.generate_state(1)[0]), n_azimuth=N_BLADE_AZIMUTH,
+                                       return_field=True)
+            t = np.arange(n) * self.dt_int
+            u_ex[:, INPUT_BLOCKS["wind"].start] = np.interp(t, wd.t, wd.rotor_effective) - lc.wind_speed
+            u_ex[:, INPUT_BLOCKS["hub_wind"].start] = np.interp(t, wd.t, wd.hub)
+            u_ex[:, INPUT_BLOCKS["shear"].start] = np.interp(t, wd.t, wd.shear_y)
+            u_ex[:, INPUT_BLOCKS["shear"].start + 1] = np.interp(t, wd.t, wd.shear_z)
+            radii = np.asarray(wd.polar_radii, float)
+            w_r = np.where(radii > 0, radii, 0.0)
+            w_r /= w_r.sum()
+            on_blade = np.einsum("tra,r->ta", wd.polar_u, w_r)  # (n_field, n_azimuth)
+            idx = t / FIELD_DT
+            i0 = np.minimum(idx.astype(int), on_blade.shape[0] - 2)
+            frac = (idx - i0)[:, None]
+            blade = ((1.0 - frac) * on_blade[i0] + frac * on_blade[i0 + 1]).astype(np.float32)
         psi0 = float(np.random.default_rng(psi_ss).uniform(0.0, 2.0 * np.pi))
-        return np.ascontiguousarray(u_ex), vel, psi0
+        return np.ascontiguousarray(u_ex), vel, psi0, np.ascontiguousarray(blade)
 
     def exogenous(self, u_ex: np.ndarray) -> np.ndarray:
         """Contribution of the exogenous inputs (first-order hold) to each next state, shape (n_steps, 22)."""
@@ -565,12 +636,12 @@ def simulate(
     x_start, ctrl_start = sim.initial_state(initial)
 
     def run_one(forcing_seq: np.random.SeedSequence) -> np.ndarray:
-        u_ex, vel, psi0 = sim.forcing(n_steps, forcing_seq)
+        u_ex, vel, psi0, blade = sim.forcing(n_steps, forcing_seq)
         x, ctrl = x_start.copy(), ctrl_start.copy()
         x_hist = np.zeros((n_rec, N_STATE))
         u_hist = np.zeros((n_rec, N_INPUT - N_EX))
-        sim.advance(x, ctrl, psi0, 0, n_steps, sim.substeps, sim.exogenous(u_ex), u_ex, np.zeros(2), vel, x_hist,
-                    u_hist, 0)
+        sim.advance(x, ctrl, psi0, 0, n_steps, sim.substeps, sim.exogenous(u_ex), u_ex, np.zeros(2), vel, blade,
+                    x_hist, u_hist, 0)
         return sim.outputs(x_hist[n_skip:], u_ex[out_steps], u_hist[n_skip:])
 
     # FFT synthesis, the compiled stepper (nogil) and BLAS all release the GIL: a batch runs on threads

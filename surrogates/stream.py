@@ -74,17 +74,17 @@ class StreamingSimulator:
         self._seq: np.random.SeedSequence | None = None
 
     # ---------------------------------------------------------------------------------------------- forcing
-    def _raw_chunk(self) -> tuple[np.ndarray, np.ndarray]:
+    def _raw_chunk(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         assert self._seq is not None
         child = self._seq.spawn(1)[0]
-        u_ex, vel, _ = self.sim.forcing(self.chunk + self.overlap, child)
-        return u_ex, vel
+        u_ex, vel, _, blade = self.sim.forcing(self.chunk + self.overlap, child)
+        return u_ex, vel, blade
 
     def _next_chunk(self) -> None:
         """Make the next `chunk` steps of forcing (plus one sample for the hold), crossfaded with the previous."""
-        u_new, v_new = self._raw_chunk()
+        u_new, v_new, b_new = self._raw_chunk()
         if self._tail is not None:
-            tail_u, tail_v = self._tail
+            tail_u, tail_v, tail_b = self._tail
             n = self.overlap
             theta = 0.5 * np.pi * (np.arange(n) + 0.5) / n
             c, s = np.cos(theta), np.sin(theta)
@@ -96,13 +96,19 @@ class StreamingSimulator:
                 mean[INPUT_BLOCKS["shear"]] = self.sim.mean_shear  # and the disc gradients' mean
             u_head = (tail_u - mean) * c[:, None] + (u_new[:n] - mean) * s[:, None] + mean
             v_head = tail_v * c[:, None, None] + v_new[:n] * s[:, None, None]
+            if b_new.shape[0]:
+                w_mean = self.sim.case.wind_speed
+                b_head = (tail_b - w_mean) * c[:, None] + (b_new[:n] - w_mean) * s[:, None] + w_mean
+                b_new = np.concatenate([b_head.astype(np.float32), b_new[n:]])
             u_new = np.concatenate([u_head, u_new[n:]])
             v_new = np.concatenate([v_head, v_new[n:]])
         # keep `chunk + 1` samples for this chunk; the rest is the tail to crossfade into the next one
         self._u = np.ascontiguousarray(u_new[: self.chunk + 1])
         self._vel = np.ascontiguousarray(v_new[: self.chunk + 1])
+        self._blade = np.ascontiguousarray(b_new[: self.chunk + 1])
         self._exo = self.sim.exogenous(self._u)
-        self._tail = (u_new[self.chunk: self.chunk + self.overlap], v_new[self.chunk: self.chunk + self.overlap])
+        self._tail = (u_new[self.chunk: self.chunk + self.overlap], v_new[self.chunk: self.chunk + self.overlap],
+                      b_new[self.chunk: self.chunk + self.overlap])
         self._k = 0
 
     # ------------------------------------------------------------------------------------------------- API
@@ -140,7 +146,7 @@ class StreamingSimulator:
         x_hist = np.zeros((1, N_STATE))
         u_hist = np.zeros((1, N_INPUT - N_EX))
         self.sim.advance(self.x.copy(), self.ctrl.copy(), self.psi, self._k, 1, 1, self._exo, self._u, np.zeros(2),
-                         self._vel, x_hist, u_hist, 0)
+                         self._vel, self._blade, x_hist, u_hist, 0)
         return self.sim.outputs(x_hist, self._u[self._k: self._k + 1], u_hist)[0]
 
     def advance(self, n_samples: int, action: np.ndarray, noise: bool = True) -> tuple[np.ndarray, np.ndarray]:
@@ -175,7 +181,7 @@ class StreamingSimulator:
             m = min(room, n_samples - done)
             buf[done: done + m, N_STATE: N_STATE + N_EX] = self._u[self._k: self._k + m * self.substeps: self.substeps]
             self.psi = sim.advance(self.x, self.ctrl, self.psi, self._k, m * self.substeps, self.substeps,
-                                   self._exo, self._u, act, self._vel, out_x,
+                                   self._exo, self._u, act, self._vel, self._blade, out_x,
                                    out_u, done)
             self._k += m * self.substeps
             done += m

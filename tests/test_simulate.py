@@ -157,7 +157,7 @@ def test_linear_simulation_matches_lsim_of_linearize():
     rec = surrogates.simulate(model, case, duration=duration, dt=dt, seed=seed, transient=0.0, noise=False)
     sim = Simulator(model, case, dt)
     n = rec.n_samples
-    u_ex, _, _ = sim.forcing(n * sim.substeps, np.random.SeedSequence(seed).spawn(2)[0])
+    u_ex, _, _, _ = sim.forcing(n * sim.substeps, np.random.SeedSequence(seed).spawn(2)[0])
     ss = model.linearize(case)
     cols = [ss.input_labels.index(k) for k in ss.input_labels]
     u = np.zeros((n, ss.ninputs))
