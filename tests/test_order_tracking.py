@@ -111,3 +111,19 @@ def test_bad_input_gets_clear_errors():
 
 def test_docstring_example_runs():
     assert doctest.testmod(ot).failed == 0
+
+
+def test_many_channels_are_tracked_on_their_leading_components():
+    """Issue 19: 36 channels are reduced to 8 principal components before the Hankel-DMD (Gram matrices of
+    8 x delays rows, not 36 x delays): the 3P line at order 3 and 3 x mean 1P, the same as with every channel."""
+    Y3, dt, w = _turbine_like(0, duration=600.0)
+    f3 = 3 * np.mean(w) / (2 * np.pi)
+    rng = np.random.default_rng(5)
+    Y = Y3 @ rng.uniform(0.2, 1.0, (3, 36)) + 0.05 * rng.standard_normal((Y3.shape[0], 36))
+    reduced = rotor_harmonics(Y, dt, rotor_speed=w, delays=(30, 40, 50), rank=12)
+    full = rotor_harmonics(Y, dt, rotor_speed=w, delays=(30, 40, 50), rank=12, components=None)
+    assert [round(h["order"], 2) for h in reduced] == [round(h["order"], 2) for h in full] == [3.0]
+    assert reduced[0]["frequency_hz"] == pytest.approx(f3, rel=0.01)
+    assert reduced[0]["frequency_hz"] == pytest.approx(full[0]["frequency_hz"], rel=1e-3)
+    with pytest.raises(ValueError, match="components"):
+        rotor_harmonics(Y, dt, rotor_speed=w, components=0)
