@@ -566,7 +566,7 @@ class Simulator:
 def simulate(
     model: FOWTModel,
     case: int | LoadCase | None,
-    duration: float = 600.0,
+    duration: float | None = None,
     dt: float = 0.0125,
     seed: int | Sequence[int] = 0,
     *,
@@ -574,6 +574,8 @@ def simulate(
     noise: bool = True,
     return_truth: bool = False,
     initial: Mapping[str, float] | None = None,
+    waves: object = None,
+    wind: object = None,
 ) -> Record | list[Record]:
     """Simulate the surrogate under a load case and return its 45 sensor channels.
 
@@ -583,8 +585,9 @@ def simulate(
         The model (its effects, rotor harmonics and sensor noise).
     case : int or LoadCase or None
         OLC number (1-12), a :class:`LoadCase`, or None (parked, still water, no wind).
-    duration : float
-        Length of the returned record (s).
+    duration : float or None
+        Length of the returned record (s); None: 600 s, or with replayed inputs everything they cover after the
+        transient.
     dt : float
         Sample time (s); default 0.0125 s (80 Hz, as the paper's data).
     seed : int or sequence of int
@@ -603,6 +606,14 @@ def simulate(
         ``TTDspFA``, ``TTDspSS`` (m, set through the first tower mode of that plane) and ``RotSpeed`` (rpm).
         Unnamed states start at the static equilibrium. Use ``transient=0`` to record from the release, e.g.
         ``simulate(model, None, 300, initial={"PtfmPitch": 5.0}, transient=0)``.
+    waves : MeasuredWaves, Record or (t, elevation), optional
+        Replay a measured wave elevation (m, at the spar axis; a record's ``Wave1Elev``) instead of the JONSWAP
+        draw, see :mod:`surrogates.replay`. The case's ``hs``/``tp`` still set the drag linearisation.
+    wind : MeasuredWind, Record or (t, hub wind), optional
+        Replay a measured wind (hub series, rotor-effective series or polar field; a record's ``Wind1VelX`` is a
+        hub series) instead of the turbulence draw; the case's ``wind_speed`` is the linearisation point (use
+        the measured mean). With replayed inputs the simulation starts at the latest start of their time axes
+        and the returned record's time stamps are theirs (``transient`` later).
 
     Returns
     -------
@@ -615,9 +626,18 @@ def simulate(
     ValueError
         Non-positive or non-finite duration/dt/transient, dt too large, a bad case or model.
     """
-    duration = check_number("duration", duration, positive=True)
     if not np.isfinite(transient) or transient < 0:
         raise ValueError(f"transient must be finite and >= 0 (s), got {transient!r}")
+    replay = waves is not None or wind is not None
+    if replay:
+        from .replay import as_measured_waves, as_measured_wind, replay_forcing, replay_meta, replay_window
+
+        waves = None if waves is None else as_measured_waves(waves)
+        wind = None if wind is None else as_measured_wind(wind)
+        if duration is not None:
+            duration = check_number("duration", duration, positive=True)
+        t_start, duration = replay_window(waves, wind, duration, transient, dt)
+    duration = check_number("duration", 600.0 if duration is None else duration, positive=True)
     batch = not np.isscalar(seed)
     seeds = [int(s) for s in (seed if batch else [seed])]  # type: ignore[union-attr]
     if any(s < 0 for s in seeds):
@@ -636,7 +656,10 @@ def simulate(
     x_start, ctrl_start = sim.initial_state(initial)
 
     def run_one(forcing_seq: np.random.SeedSequence) -> np.ndarray:
-        u_ex, vel, psi0, blade = sim.forcing(n_steps, forcing_seq)
+        if replay:
+            u_ex, vel, psi0, blade = replay_forcing(sim, n_steps, t_start, waves, wind, forcing_seq)
+        else:
+            u_ex, vel, psi0, blade = sim.forcing(n_steps, forcing_seq)
         x, ctrl = x_start.copy(), ctrl_start.copy()
         x_hist = np.zeros((n_rec, N_STATE))
         u_hist = np.zeros((n_rec, N_INPUT - N_EX))
@@ -652,6 +675,8 @@ def simulate(
             y_outs = list(pool.map(lambda ch: run_one(ch[0]), children))
     lc = sim.case
     t = np.arange(n_out) * sim.dt
+    if replay:
+        t = t + (t_start + n_skip * sim.dt)
     out: list = []
     for s, ch, truth in zip(seeds, children, y_outs, strict=True):
         if not np.all(np.isfinite(truth)):
@@ -666,6 +691,8 @@ def simulate(
             "noise": bool(noise),
             "initial": dict(initial) if initial else None,
         }
+        if replay:
+            meta["replay"] = replay_meta(waves, wind, t_start)
         noisy = sim.add_noise(truth, ch[1]) if noise else truth
         rec = Record(t, noisy, list(ALL_CHANNELS), [UNITS[c] for c in ALL_CHANNELS], meta)
         if return_truth:
