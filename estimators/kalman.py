@@ -213,6 +213,12 @@ class KalmanSensor:
     the sensors out: after a blackout the model's prediction is typically much further off than its covariance
     says (the real loads are not the AR(1) process the model assumes), and a test on the prior innovation would
     reject every returning channel for seconds. With a single live channel the test is the prior-innovation one.
+    Conversely a channel is only rejected if its prior innovation ``|e_i| / sqrt(S_ii)`` is beyond the gate too:
+    when the prior is wide (after a blackout) ``S`` is nearly singular along the relations the linear model
+    imposes between channels (adjacent bending moments, whose noise is tiny), and the truth's small departures
+    from those relations (its nonlinear loads) read as many leave-one-out standard deviations although every
+    channel is well inside its prior band. On the OC3 surrogate without gravity in the accelerations this
+    rejected good moment channels for 1.6 s after a 3 s blackout and made the hidden moments 4-25 times worse.
 
     The noise model is white: slowly varying (coloured) sensor errors and the model's own errors are read as
     structural response, which makes the filter's standard deviations of unmeasured channels optimistic. The
@@ -815,6 +821,11 @@ class KalmanSensor:
                     with np.errstate(over="ignore", invalid="ignore"):
                         loo = np.abs(ui @ we) / np.sqrt(np.einsum("ij,ij->i", ui, ui))
                     loo = np.where(np.isnan(loo), np.inf, loo)  # an overflowed residual is an outlier, not NaN
+                    # an outlier also surprises the prior: a channel within the gate of its own prior prediction
+                    # is what the model expects of it, whatever the others say (see Notes)
+                    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                        prior = np.abs(e) / np.sqrt(np.diagonal(s))
+                    loo = np.where(np.isnan(prior) | (prior > gate), loo, 0.0)
                     worst = int(np.argmax(loo))
                     if loo[worst] > gate:
                         self.n_gated_ += 1
