@@ -603,7 +603,9 @@ def simulate(
     initial : mapping, optional
         Initial conditions for a free decay or a start-up, OpenFAST channel name -> value in OpenFAST units:
         ``PtfmSurge``, ``PtfmSway``, ``PtfmHeave`` (m), ``PtfmRoll``, ``PtfmPitch``, ``PtfmYaw`` (deg),
-        ``TTDspFA``, ``TTDspSS`` (m, set through the first tower mode of that plane) and ``RotSpeed`` (rpm).
+        ``TTDspFA``, ``TTDspSS`` (m, set through the first tower mode of that plane), ``RotSpeed`` (rpm) and
+        ``Azimuth`` (deg, blade 1 up = 0, increasing clockwise looking downwind, as OpenFAST's; default drawn
+        from the seed).
         Unnamed states start at the static equilibrium. Use ``transient=0`` to record from the release, e.g.
         ``simulate(model, None, 300, initial={"PtfmPitch": 5.0}, transient=0)``.
     waves : MeasuredWaves, Record or (t, elevation), optional
@@ -653,13 +655,19 @@ def simulate(
     n_rec = n_out + n_skip
     out_steps = np.arange(n_skip, n_rec) * sim.substeps
 
-    x_start, ctrl_start = sim.initial_state(initial)
+    initial = dict(initial) if initial else None
+    psi_start = None
+    if initial and "Azimuth" in initial:  # the rotor's azimuth is not a state of x: it seeds the stepper
+        psi_start = math.radians(check_number("initial['Azimuth']", initial["Azimuth"]))
+    x_start, ctrl_start = sim.initial_state({k: v for k, v in initial.items() if k != "Azimuth"} if initial else None)
 
     def run_one(forcing_seq: np.random.SeedSequence) -> np.ndarray:
         if replay:
             u_ex, vel, psi0, blade = replay_forcing(sim, n_steps, t_start, waves, wind, forcing_seq)
         else:
             u_ex, vel, psi0, blade = sim.forcing(n_steps, forcing_seq)
+        if psi_start is not None:
+            psi0 = psi_start
         x, ctrl = x_start.copy(), ctrl_start.copy()
         x_hist = np.zeros((n_rec, N_STATE))
         u_hist = np.zeros((n_rec, N_INPUT - N_EX))
