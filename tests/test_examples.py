@@ -91,7 +91,7 @@ def test_01_sea_state_from_the_record_matches_the_load_case(lesson):
 
 
 def test_02_modes_are_the_models_and_near_the_oc3_reference(lesson):
-    _, r, _ = lesson("02")
+    module, r, _ = lesson("02")
     model = surrogates.FOWTModel()
     parked = model.modal_analysis()
     for label in ("tower_fa_1", "tower_ss_1", "pitch", "heave"):
@@ -101,10 +101,21 @@ def test_02_modes_are_the_models_and_near_the_oc3_reference(lesson):
     assert r["frequencies_hz"]["tower_ss_1"] == pytest.approx(0.492, rel=0.05)
     assert r["frequencies_hz"]["pitch"] == pytest.approx(0.0343, rel=0.05)
     assert r["frequencies_hz"]["heave"] == pytest.approx(0.0324, rel=0.05)
-    # the turning rotor damps fore-aft motion (aerodynamic damping), not side-to-side
-    assert r["operating_damping_ratios"]["tower_fa_1"] > 1.5 * r["damping_ratios"]["tower_fa_1"]
-    assert r["operating_damping_ratios"]["pitch"] > 2.0 * r["damping_ratios"]["pitch"]
-    assert r["operating_damping_ratios"]["tower_ss_1"] == pytest.approx(r["damping_ratios"]["tower_ss_1"], rel=0.1)
+    # Aerodynamic damping = the operating point against itself with aero_damping off. (Was: against parked, but
+    # the Morison drag is now linearised about each sea state's response, so the platform is damped more by
+    # the water in waves too, and the rotor is under the DISCON controller, whose sign flips at rated.)
+    op, op_still = r["operating_damping_ratios"], r["operating_no_aero_damping_ratios"]
+    below, below_still = r["below_rated_damping_ratios"], r["below_rated_no_aero_damping_ratios"]
+    assert r["below_rated_wind_speed"] < 11.4 < surrogates.load_case(module.CASE).wind_speed  # rated: DESIGN.md
+    # the turning rotor damps fore-aft tower motion in both control regions, not side-to-side
+    for z, z_still in ((op, op_still), (below, below_still)):
+        assert z["tower_fa_1"] > 1.5 * z_still["tower_fa_1"]
+        assert z["tower_ss_1"] == pytest.approx(z_still["tower_ss_1"], rel=0.1)
+    # platform pitch: damped by the rotor below rated; above rated the constant-power pitch controller takes
+    # damping away (thrust falls as the platform moves upwind: Larsen & Hanson 2007, Jonkman 2008
+    # NREL/CP-500-42589), and OC3's detuned controller leaves it positive
+    assert below["pitch"] > 2.0 * below_still["pitch"]
+    assert 0.0 < op["pitch"] < op_still["pitch"]
 
 
 def test_03_blade_passing_adds_energy_at_3p_and_6p_only(lesson):
