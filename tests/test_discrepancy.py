@@ -57,10 +57,16 @@ def test_two_hidden_effects_are_both_named():
 
 
 def test_findings_localise_a_hidden_3p_effect(tmp_path):
-    """Quick check of 'where': a missing blade-passing effect shows up in the 3P bands."""
-    measured = surrogates.simulate(FULL, 4, duration=600.0, dt=DT, seed=3)
-    rep = discrepancy.run(measured, FULL.without("rotor_3p"), surrogates.load_case(4), n_seeds=3,
-                          candidates=["rotor_3p", "p_delta"])
+    """Quick check of 'where': a missing blade-passing effect shows up in the 3P bands.
+
+    In steady wind: the 3P amplitudes are OpenFAST's in steady 12 m/s wind (tower shadow and shear, 1.6 % of the
+    thrust, ``surrogates.RotorHarmonics``), and under OLC 4's 17 % turbulence the rotationally sampled turbulence
+    puts over ten times more power in the 3P band than they do (their band powers change by < 0.1 in log, inside the
+    seed scatter), so no feature can see them there -- as in OpenFAST, where turbulence dominates 3P.
+    """
+    case = surrogates.load_case(4).replace(turbulence_intensity=0.0)
+    measured = surrogates.simulate(FULL, case, duration=300.0, dt=DT, seed=3)  # steady wind: 300 s suffice
+    rep = discrepancy.run(measured, FULL.without("rotor_3p"), case, n_seeds=3, candidates=["rotor_3p", "p_delta"])
     assert rep.findings and all(f["band_or_statistic"] == "3P" for f in rep.findings[:3])
     assert rep.effect == "rotor_3p"
     path = rep.plot(tmp_path / "d.png")
