@@ -121,7 +121,13 @@ def test_paper_scenarios_on_short_surrogate_data(spar):
     for name in "ABC":
         r2 = scenario_r2(surrogates, model, sensor, name, duration=120.0)
         print(f"\nDMD sensor, scenario {name}: hidden R2 {np.round(r2, 4)}")
-        assert np.median(r2) >= 0.95 and r2.min() >= 0.85
+        # Was the target (median >= 0.95, min >= 0.85; kept by the slow test on 9 OLCs x 300 s). Since
+        # the physics follows OpenFAST, 2 min of 3 OLCs fall short of it for two physical reasons: the nacelle
+        # moment TwHt9MLyt is driven directly by the rotor's tilt moment from rotationally sampled turbulence, a
+        # broadband load no other channel sees in advance (R2 0.79-0.83; 0.94 with rotor_asymmetry off), and the
+        # accelerations no longer carry gravity's share of the slow, predictable platform pitch (0.90-0.95).
+        # A sensor that has lost the dynamics scores near 0 on these channels (they are hidden throughout).
+        assert np.median(r2) >= 0.85 and r2.min() >= 0.75
 
 
 def test_accuracy_falls_with_the_update_interval(spar):
@@ -151,7 +157,12 @@ def test_nan_in_live_channels_is_a_dropout(spar):
     est_masked = sensor.reconstruct(y, mask & ~holes)
     assert np.all(np.isfinite(est_nan))
     np.testing.assert_array_equal(est_nan, est_masked)
-    assert r2_score(truth, est_nan)[[0, 8, 9, 17]].min() > 0.9
+    # 5 % of the live samples lost cost the hidden channels next to nothing; the floor is the clean run's
+    # nacelle moment TwHt9MLyt (R2 ~0.76: driven by the rotor's turbulent tilt moment, see the scenario test)
+    hidden = [0, 8, 9, 17]
+    clean = r2_score(truth, sensor.reconstruct(y, mask))[hidden]
+    assert np.all(r2_score(truth, est_nan)[hidden] > clean - 0.01)
+    assert clean.min() > 0.7 and np.median(clean) > 0.9
 
 
 def test_total_blackout_runs_open_loop_and_recovers(spar):
@@ -181,7 +192,10 @@ def test_mask_changing_every_sample(spar):
     # score each channel on the samples where it was lost
     r2 = np.array([r2_score(truth[lost[:, c], c], est[lost[:, c], c]) for c in range(18)])
     print(f"\nmask changing every sample (40 % lost): R2 of lost samples {np.round(r2, 3)}")
-    assert np.median(r2) > 0.95 and r2.min() > 0.8
+    # min was > 0.8: the nacelle moment TwHt9MLyt (channel 17) now carries the rotor's turbulent tilt moment,
+    # which the other channels do not see (~0.76, see the scenario test); every other channel > 0.9
+    assert np.median(r2) > 0.95 and r2.min() > 0.7
+    assert np.delete(r2, 17).min() > 0.9
 
 
 def test_spikes_and_a_stuck_sensor_are_gated(spar):
