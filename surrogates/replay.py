@@ -18,12 +18,15 @@ Honest edges and band:
   ``taper_s``, faded to zero (cosine half-windows), and zero-padded before the FFT, so it is neither treated as
   periodic nor cut with a jump. The elevation -> load transfer functions are zero-phase low-pass kernels a few
   seconds long (the deep-water depth decay ``exp(omega^2 z / g)``), so the loads are exact except within those
-  few seconds of either end, where the unknown past/future of the sea is stood in for by the mirror image.
+  few seconds of either end, where the unknown past/future of the sea is stood in for by the mirror image
+  (the elevation itself by up to a few percent in the last second, from the kink at the reflection).
   Discard a start-up of a few platform periods
   (:func:`surrogates.simulate`'s ``transient``, 60 s or more) -- the platform starts from rest at its mean
   offset and the slow surge mode (~125 s) needs that long to forget it;
-* reproduced band: ``f_min_hz`` (default 0.02 Hz, below any sea's energy; lower content of a measured elevation
-  is drift or tide) to ``f_max_hz`` (default the lower of 2 Hz and the record's Nyquist frequency). Above about
+* reproduced band: ``f_min_hz`` (default 0: everything but the mean; a brick-wall cut inside the record's
+  content rings, and the deep strips' velocities, which peak near 0.03 Hz, magnify that ringing -- give a
+  cut only to remove drift or tide, below the sea's energy) to ``f_max_hz`` (default the lower of 2 Hz and the
+  record's Nyquist frequency). Above about
   0.2 Hz the loads lack diffraction (Morison inertia, see :mod:`surrogates.waves`), as in the random synthesis.
 
 Wind (:class:`MeasuredWind`), three levels
@@ -132,8 +135,9 @@ def _extend(x: np.ndarray, dt: float, taper_s: float) -> tuple[np.ndarray, int]:
     """``x`` (mean removed) extended at both ends by its mirror image over ``taper_s``, faded to zero there by
     cosine half-windows; returns the extended series and the number of samples added at each end.
 
-    The record itself is left intact; the even reflection keeps the series continuous at its ends, and the fade
-    lets the zero padding that follows meet it without a jump."""
+    The record itself is left intact; the even reflection keeps the series continuous at its ends (a point
+    reflection would also keep the slope, but drifts and puts spurious low-frequency content into the deep
+    strips' kinematics), and the fade lets the zero padding that follows meet it without a jump."""
     n = x.size
     m = min(int(round(taper_s / dt)), n - 1)
     x = x - x.mean()
@@ -184,7 +188,7 @@ class MeasuredWaves:
     direction_deg : float or None
         Propagation direction (deg; 0 = along +x, downwind). None: the load case's ``wave_dir_deg``.
     f_min_hz, f_max_hz : float
-        Band replayed (Hz). Default 0.02 Hz and the lower of 2 Hz and the Nyquist frequency.
+        Band replayed (Hz). Default 0 (all but the mean) and the lower of 2 Hz and the Nyquist frequency.
     taper_s : float
         Length of the faded mirror extension at each end (s), default :data:`DEFAULT_TAPER_S`.
     source : str
@@ -201,7 +205,7 @@ class MeasuredWaves:
     t: np.ndarray
     elevation: np.ndarray
     direction_deg: float | None = None
-    f_min_hz: float = 0.02
+    f_min_hz: float = 0.0
     f_max_hz: float | None = None
     taper_s: float = DEFAULT_TAPER_S
     source: str = ""

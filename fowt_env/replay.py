@@ -1,0 +1,336 @@
+"""Replay a measured record through the surrogate and score it sample by sample, against the linear bound.
+
+:func:`replay_record` drives :func:`surrogates.simulate` with a record's measured wave elevation (``Wave1Elev``)
+and wind (its ``Wind1VelX``, or a richer wind given beside it: an OpenFAST reference ``*.inflow.npz`` or a
+TurbSim ``.bts`` full field), under the record's own conditions (a ``<run>.case.json`` sidecar, else estimated
+from the record), starting from the record's first sample (platform position, tower-top deflection, rotor speed).
+
+:func:`replay_scores` compares the replay with the record channel by channel and band by band:
+
+* ``r2``: the coefficient of determination of the surrogate's series against the record's, after both are
+  band-passed (zero-phase FFT mask) and their own means removed, ``1 - sum (y - y_hat)^2 / sum (y - mean y)^2``;
+* ``bound``: the fraction of the record's variance in the band that is linearly explained by the two inputs,
+  wave elevation and rotor-averaged wind: the **multiple coherence** ``gamma^2(f) = S_yx S_xx^-1 S_xy / S_yy``
+  (Welch cross-spectra of the record itself, :func:`multiple_coherence`) averaged over the band with weights
+  ``S_yy`` (:func:`coherence_bound`). A model driven by these inputs cannot exceed it with linear dynamics; a
+  nonlinear model may.
+
+Examples
+--------
+>>> import numpy as np
+>>> rng = np.random.default_rng(0)
+>>> x = rng.standard_normal((20000, 2))
+>>> y = x[:, 0] + 0.5 * x[:, 1] + 0.5 * rng.standard_normal(20000)
+>>> round(coherence_bound(y, x, fs=10.0, band=(0.0, 5.0), segment_s=100.0), 1)   # 1.25 / 1.5
+0.8
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import signal
+
+__all__ = [
+    "REPLAY_BANDS",
+    "REPLAY_CHANNELS",
+    "ReplayScore",
+    "band_pass",
+    "band_r2",
+    "coherence_bound",
+    "multiple_coherence",
+    "record_case",
+    "record_initial",
+    "replay_record",
+    "replay_scores",
+    "scores_table",
+]
+
+REPLAY_BANDS: dict[str, tuple[float, float]] = {"wave": (0.05, 0.25), "0-1 Hz": (0.0, 1.0)}
+"""Bands (Hz) in which replays are scored: the wave band and everything up to 1 Hz."""
+
+REPLAY_CHANNELS: tuple[str, ...] = ("PtfmSurge", "PtfmHeave", "PtfmPitch", "TwrBsMyt", "TwHt9ALxt", "RotSpeed",
+                                    "BldPitch1")
+"""Channels scored by default (issue 16's list)."""
+
+SEGMENT_S = 100.0
+"""Welch segment length (s) of the coherence bound: 0.01 Hz resolution, ~10 averages over a 600 s record."""
+
+_INITIAL_CHANNELS = ("PtfmSurge", "PtfmSway", "PtfmHeave", "PtfmRoll", "PtfmPitch", "PtfmYaw", "TTDspFA", "TTDspSS",
+                     "RotSpeed", "Azimuth")
+
+
+# -------------------------------------------------------------------------------------------- statistics
+def _series(x: ArrayLike, name: str) -> NDArray[np.float64]:
+    a = np.asarray(x, dtype=float)
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} holds NaN or inf")
+    return a
+
+
+def band_pass(x: ArrayLike, fs: float, band: tuple[float, float]) -> NDArray[np.float64]:
+    """Zero-phase band-pass by an FFT mask (``lo <= f <= hi``), mean removed (``fs`` in Hz, band in Hz)."""
+    a = _series(x, "x")
+    spec = np.fft.rfft(a - a.mean())
+    f = np.fft.rfftfreq(a.size, 1.0 / fs)
+    spec[(f < band[0]) | (f > band[1]) | (f == 0.0)] = 0.0
+    return np.fft.irfft(spec, n=a.size)
+
+
+def band_r2(reference: ArrayLike, model: ArrayLike, fs: float, band: tuple[float, float]) -> float:
+    """R² of ``model`` against ``reference`` in a band (both band-passed, own means removed; -)."""
+    r = band_pass(reference, fs, band)
+    m = band_pass(model, fs, band)
+    if r.shape != m.shape:
+        raise ValueError(f"reference and model must have the same length, got {r.shape} and {m.shape}")
+    sst = float(np.sum(r * r))
+    return 1.0 - float(np.sum((r - m) ** 2)) / sst if sst > 0 else math.nan
+
+
+def multiple_coherence(y: ArrayLike, inputs: ArrayLike, fs: float, segment_s: float = SEGMENT_S
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Multiple coherence of ``y`` with the columns of ``inputs`` (Welch, Hann, 50 % overlap).
+
+    ``gamma^2(f) = S_yx(f) S_xx(f)^-1 S_xy(f) / S_yy(f)``, the fraction of the power of ``y`` at ``f`` that a
+    linear time-invariant system driven by the inputs can explain.
+
+    Parameters
+    ----------
+    y : array_like (n,)
+    inputs : array_like (n, m)
+    fs : float
+        Sample rate (Hz).
+    segment_s : float
+        Welch segment (s).
+
+    Returns
+    -------
+    f (Hz), gamma2 (-), S_yy (one-sided PSD of y)
+    """
+    yy = _series(y, "y")
+    xx = _series(inputs, "inputs")
+    if xx.ndim == 1:
+        xx = xx[:, None]
+    if xx.shape[0] != yy.size:
+        raise ValueError(f"inputs have {xx.shape[0]} samples, y has {yy.size}")
+    nper = min(yy.size, int(round(segment_s * fs)))
+    kw = {"fs": fs, "nperseg": nper, "detrend": "constant"}
+    m = xx.shape[1]
+    f, s_yy = signal.welch(yy, **kw)
+    s_xx = np.empty((f.size, m, m), dtype=complex)
+    s_xy = np.empty((f.size, m), dtype=complex)
+    for i in range(m):
+        for j in range(m):
+            s_xx[:, i, j] = signal.csd(xx[:, i], xx[:, j], **kw)[1]
+        s_xy[:, i] = signal.csd(xx[:, i], yy, **kw)[1]
+    g = np.zeros(f.size)
+    ok = s_yy > 0
+    sol = np.linalg.solve(s_xx[ok] + 1e-30 * np.eye(m), s_xy[ok][..., None])[..., 0]
+    g[ok] = np.real(np.einsum("fi,fi->f", np.conj(s_xy[ok]), sol)) / s_yy[ok]
+    return f, np.clip(g, 0.0, 1.0), s_yy
+
+
+def coherence_bound(y: ArrayLike, inputs: ArrayLike, fs: float, band: tuple[float, float],
+                    segment_s: float = SEGMENT_S) -> float:
+    """Share of the variance of ``y`` in ``band`` (Hz) linearly explained by ``inputs``: the ``S_yy``-weighted
+    band average of :func:`multiple_coherence` (-), the R² a linear model driven by the inputs can reach."""
+    f, g, s = multiple_coherence(y, inputs, fs, segment_s)
+    sel = (f >= band[0]) & (f <= band[1]) & (f > 0)
+    tot = float(np.sum(s[sel]))
+    return float(np.sum(g[sel] * s[sel]) / tot) if tot > 0 else math.nan
+
+
+# --------------------------------------------------------------------------------------------- the replay
+def record_case(record: Any, case: Mapping[str, Any] | None = None) -> Any:
+    """The surrogate's load case for a measured record: its ``case.json`` content when given (wind speed
+    replaced by the record's mean ``Wind1VelX``, the linearisation point), else estimated from the record
+    (mean hub wind, Hs = 4 std and Tp of ``Wave1Elev``, IEC class B turbulence)."""
+    from surrogates.replay import sea_state
+
+    from .validation import surrogate_case
+
+    c: dict[str, Any] = dict(case or {})
+    c.pop("initial", None)
+    if "Wind1VelX" in record.channels:
+        c["wind_speed"] = float(np.mean(record["Wind1VelX"]))
+    if not c.get("hs") and "Wave1Elev" in record.channels:
+        c["hs"], c["tp"] = sea_state(record.t, record["Wave1Elev"])
+    c.setdefault("name", "replay")
+    return surrogate_case(c)
+
+
+def record_initial(record: Any) -> dict[str, float]:
+    """Initial conditions (OpenFAST names and units) from a record's first sample: platform DOFs, tower-top
+    deflections, rotor speed and azimuth, those the record has."""
+    return {c: float(record[c][0]) for c in _INITIAL_CHANNELS if c in record.channels}
+
+
+def _sidecar(path: Path, suffix: str) -> Path | None:
+    name = path.name
+    for ext in (".outb", ".out", ".npz", ".csv", ".parquet"):
+        if name.lower().endswith(ext):
+            cand = path.with_name(name[: -len(ext)] + suffix)
+            return cand if cand.is_file() else None
+    return None
+
+
+def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: Any = None, model: Any = None,
+                  transient: float = 100.0, dt: float = 0.025, initial: bool = True, seed: int = 0) -> Any:
+    """Simulate the surrogate under a record's measured waves and wind.
+
+    Parameters
+    ----------
+    record : surrogates.Record or path
+        A record with ``Wave1Elev`` (m) and/or ``Wind1VelX`` (m/s); a path is read with
+        :func:`fowt_env.io.load_record`, and a ``<run>.case.json`` and ``<run>.inflow.npz`` beside it are used.
+    case : mapping, optional
+        The run's conditions (``case.json`` keys); default the sidecar, else estimated (:func:`record_case`).
+    wind : surrogates.replay.MeasuredWind or path, optional
+        A richer wind than the record's ``Wind1VelX``: a ``MeasuredWind``, an ``*.inflow.npz`` (polar field) or a
+        TurbSim ``.bts`` (full field). Default: the inflow sidecar if there is one, else ``Wind1VelX``.
+    model : surrogates.FOWTModel, optional
+        Default: the model with OpenFAST's gauge heights, no sensor noise.
+    transient : float
+        Start-up discarded (s).
+    dt : float
+        Output sample time (s).
+    initial : bool
+        Start from the record's first sample (:func:`record_initial`) instead of the static equilibrium.
+    seed : int
+        Seeds only the rotor's initial azimuth.
+
+    Returns
+    -------
+    surrogates.Record
+        Noise-free; time stamps on the record's own axis, from ``record.t[0] + transient``.
+    """
+    import surrogates
+    from surrogates.replay import MeasuredWaves, MeasuredWind
+
+    from .io import load_record
+
+    src: Path | None = None
+    if isinstance(record, str | os.PathLike):
+        src = Path(record)
+        record = load_record(src, unknown_channels="keep")
+    if case is None and src is not None:
+        cj = _sidecar(src, ".case.json")
+        case = json.loads(cj.read_text(encoding="utf-8")) if cj else None
+    if wind is None and src is not None:
+        wind = _sidecar(src, ".inflow.npz")
+    if isinstance(wind, str | os.PathLike):
+        p = Path(wind)
+        if p.suffix.lower() == ".bts":
+            from .turbsim import measured_wind_from_bts
+
+            wind = measured_wind_from_bts(p)
+        else:
+            wind = MeasuredWind.from_inflow(p)
+    lc = record_case(record, case)
+    if model is None:
+        model = surrogates.FOWTModel(gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS)
+    waves_in = MeasuredWaves.from_record(record) if "Wave1Elev" in record.channels and lc.hs > 0 else None
+    wind_in = wind if wind is not None else (
+        MeasuredWind.from_record(record) if "Wind1VelX" in record.channels and lc.wind_speed > 0 else None)
+    if waves_in is None and wind_in is None:
+        raise ValueError("the record has neither a wave elevation (Wave1Elev) nor a wind (Wind1VelX) to replay")
+    init = record_initial(record) if initial else None
+    if init and lc.wind_speed <= 0:
+        init.pop("RotSpeed", None)
+        init.pop("Azimuth", None)
+    return surrogates.simulate(model, lc, dt=dt, seed=seed, transient=transient, noise=False, initial=init,
+                               waves=waves_in, wind=wind_in)
+
+
+@dataclass
+class ReplayScore:
+    """Replay against a record for one channel and band: R² and its linear bound (see the module docstring)."""
+
+    channel: str
+    band: str
+    r2: float
+    bound: float
+    reference_std: float
+    model_std: float
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"channel": self.channel, "band": self.band, "r2": self.r2, "bound": self.bound,
+                "reference_std": self.reference_std, "model_std": self.model_std, **self.extra}
+
+
+def _on_grid(t_src: NDArray[np.float64], x: NDArray[np.float64], t: NDArray[np.float64]) -> NDArray[np.float64]:
+    return np.interp(t, t_src, x)
+
+
+def replay_scores(reference: Any, replay: Any, rotor_wind: tuple[ArrayLike, ArrayLike] | None = None,
+                  channels: Sequence[str] = REPLAY_CHANNELS,
+                  bands: Mapping[str, tuple[float, float]] | None = None, segment_s: float = SEGMENT_S,
+                  ) -> list[ReplayScore]:
+    """Score a replay against its reference record over the replay's time span.
+
+    Parameters
+    ----------
+    reference, replay : surrogates.Record
+        The measured record and :func:`replay_record`'s output (same time axis, any rates).
+    rotor_wind : (t, u), optional
+        Rotor-averaged wind (s, m/s) for the bound; default the reference's ``Wind1VelX``.
+    channels, bands, segment_s
+        What to score (default :data:`REPLAY_CHANNELS`, :data:`REPLAY_BANDS`) and the Welch segment (s).
+
+    Returns
+    -------
+    list of ReplayScore
+    """
+    bands = dict(REPLAY_BANDS if bands is None else bands)
+    t = np.asarray(replay.t, float)
+    fs = 1.0 / float(np.median(np.diff(t)))
+    if t[0] < reference.t[0] - 1e-6 or t[-1] > reference.t[-1] + 1e-6:
+        raise ValueError("the replay reaches outside the reference record's time span")
+    rt = np.asarray(reference.t, float)
+    elev = _on_grid(rt, np.asarray(reference["Wave1Elev"], float), t)
+    if rotor_wind is None:
+        wind = _on_grid(rt, np.asarray(reference["Wind1VelX"], float), t)
+    else:
+        wind = np.interp(t, np.asarray(rotor_wind[0], float), np.asarray(rotor_wind[1], float))
+    inputs = np.column_stack([elev, wind]) if np.std(wind) > 1e-9 else elev[:, None]
+    out: list[ReplayScore] = []
+    for ch in channels:
+        if ch not in reference.channels or ch not in replay.channels:
+            continue
+        y = _on_grid(rt, np.asarray(reference[ch], float), t)
+        m = np.asarray(replay[ch], float)
+        for name, band in bands.items():
+            out.append(ReplayScore(ch, name, band_r2(y, m, fs, band), coherence_bound(y, inputs, fs, band, segment_s),
+                                   float(np.std(band_pass(y, fs, band))), float(np.std(band_pass(m, fs, band))),
+                                   {"reference_mean": float(np.mean(y)), "model_mean": float(np.mean(m))}))
+    return out
+
+
+def scores_table(scores: Sequence[ReplayScore], run: str = "") -> str:
+    """Markdown table: per channel, R² and bound per band, and whether R² >= 0.85 x bound."""
+    bands = list(dict.fromkeys(s.band for s in scores))
+    head = "| run | channel | " + " | ".join(f"R² {b} | bound {b}" for b in bands) + " |"
+    lines = [head, "|" + "---|" * (2 + 2 * len(bands))]
+    by: dict[str, dict[str, ReplayScore]] = {}
+    for s in scores:
+        by.setdefault(s.channel, {})[s.band] = s
+    for ch, d in by.items():
+        cells = []
+        for b in bands:
+            s = d.get(b)
+            if s is None or not np.isfinite(s.bound):
+                cells += ["—", "— (constant)" if s is not None else "—"]
+                continue
+            ok = s.r2 >= 0.85 * s.bound
+            cells += [f"{s.r2:.2f}{'' if ok else ' ✗'}", f"{s.bound:.2f}"]
+        lines.append(f"| {run} | {ch} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
