@@ -7,6 +7,7 @@ Examples
     fowt-env demo                                  # the main job, figures in ./fowt_demo
     fowt-env simulate --case 7 --duration 1200 --seed 3 --out olc7.npz
     fowt-env simulate --case 4 --effects none --no-noise --out linear.npz
+    fowt-env simulate --replay run.outb --wind-file run.bts --out replay.npz   # measured waves and wind
     fowt-env modes --case 7 --json modes.json
     fowt-env episode --case 5 --plane FA --fault scenario:A --fault dropout:0.1:2 --duration 120 --out ep.npz
     fowt-env identify olc7.npz --plane FA --json modes.json --plot figs
@@ -132,9 +133,43 @@ def _timed_simulation(model, case, **kwargs):
     return rec, time.perf_counter() - t0
 
 
+def _cmd_replay(args: argparse.Namespace) -> int:
+    """``simulate --replay RECORD``: the surrogate under a record's measured waves and wind."""
+    import surrogates
+
+    from .replay import REPLAY_CHANNELS, replay_record, replay_scores, scores_table
+
+    src = Path(args.replay)
+    if not src.is_file():
+        raise _UsageError(f"--replay: no such record {str(src)!r}")
+    if args.wind_file is not None and not Path(args.wind_file).is_file():
+        raise _UsageError(f"--wind-file: no such file {str(args.wind_file)!r}")
+    from .io import load_record
+
+    measured = load_record(src, unknown_channels="keep")
+    heights = getattr(surrogates, "OPENFAST_GAUGE_HEIGHTS", None)
+    model = surrogates.FOWTModel(_parse_effects(args.effects), gauge_heights=heights)
+    t0 = time.perf_counter()
+    rec = replay_record(src, wind=args.wind_file, model=model, transient=args.transient, dt=args.dt,
+                        seed=args.seed)
+    wall = time.perf_counter() - t0
+    path = _save_record(rec, args.out)
+    wind = rec.meta.get("replay", {}).get("wind") or {}
+    print(f"wrote {path}: replay of {src.name} ({rec.t[0]:.1f}-{rec.t[-1]:.1f} s; wind: "
+          f"{wind.get('level', 'none')}), {rec.n_samples} samples x {rec.n_channels} channels in {wall:.2f} s")
+    channels = [c for c in REPLAY_CHANNELS if c in measured.channels]
+    if channels and "Wave1Elev" in measured.channels and "Wind1VelX" in measured.channels:
+        print(scores_table(replay_scores(measured, rec, channels=channels), src.stem))
+    return 0
+
+
 def _cmd_simulate(args: argparse.Namespace) -> int:
     import surrogates
 
+    if args.replay is not None:
+        return _cmd_replay(args)
+    if args.wind_file is not None:
+        raise _UsageError("--wind-file needs --replay RECORD")
     model = surrogates.FOWTModel(_parse_effects(args.effects))
     rec, wall = _timed_simulation(model, _case(args.case), duration=args.duration, dt=args.dt, seed=args.seed,
                                   noise=not args.no_noise)
@@ -608,6 +643,16 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--effects", default="all", help=effects_help)
     s.add_argument("--no-noise", action="store_true", help="noise-free sensors")
     s.add_argument("--out", required=True, help="output file: .npz (lossless), .out/.outb (OpenFAST), .csv or .parquet")
+    s.add_argument("--replay", metavar="RECORD",
+                   help="replay a measured record's Wave1Elev and Wind1VelX (OpenFAST .outb/.out, .npz, CSV) under "
+                        "its conditions (<run>.case.json beside it, else estimated), from its first sample; "
+                        "--case/--duration/--no-noise are then ignored (a replay is noise-free), the output starts "
+                        "--transient s after the record")
+    s.add_argument("--wind-file", metavar="FILE",
+                   help="with --replay: a richer wind than Wind1VelX, a TurbSim .bts full field or an OpenFAST "
+                        "reference *.inflow.npz (default: <run>.inflow.npz beside the record, if any)")
+    s.add_argument("--transient", type=float, default=100.0,
+                   help="with --replay: start-up discarded, s (default 100)")
     s.set_defaults(func=_cmd_simulate)
 
     e = sub.add_parser("episode", help="run an environment episode under sensor faults and save the records")
