@@ -1187,8 +1187,10 @@ def validate(
         OpenFAST outputs of any readable format, each with a ``<run>.case.json`` sidecar
         (see :func:`load_reference`), e.g. ``shared/reference/openfast/runs``.
     model : surrogates.FOWTModel, optional
-        The surrogate; default ``surrogates.FOWTModel(gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS)`` (all
-        effects, tower gauges at the shared OpenFAST runs' heights, 11.94 ... 85.66 m above MSL).
+        The surrogate; default ``surrogates.FOWTModel(gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS)`` with
+        ``rotor_1p`` off (all other effects; tower gauges at the shared OpenFAST runs' heights, 11.94 ... 85.66 m
+        above MSL; the OC3 Hywind deck's rotor is perfectly balanced and its blades identically pitched, so it
+        has no 1P loads to compare with).
     seeds : int or sequence of int
         Number of seeds of the operating runs (``base_seed``, ``base_seed + 1``, ...) or the seeds themselves;
         default 8. The free decays are deterministic (no waves, no wind, no noise) and use one seed.
@@ -1232,6 +1234,7 @@ def validate(
     if model is None:  # the gauges where the reference deck has them (TwrGagNd of the shared runs)
         heights = getattr(surrogates, "OPENFAST_GAUGE_HEIGHTS", None)
         model = surrogates.FOWTModel() if heights is None else surrogates.FOWTModel(gauge_heights=heights)
+        model = model.with_effects(rotor_1p=0.0)  # the reference deck's rotor is balanced: no 1P loads
     seed_list = _seed_list(seeds, base_seed)
     if duration is not None and not (math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be > 0 s, got {duration!r}")

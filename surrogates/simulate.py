@@ -204,7 +204,10 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         u[rot0 + 1] = q_gen_hss
         u[rot0 + 2] = q_gen * omega * par[P_GENEFF]
         u[rot0 + 3] = thrust
-    # --- rotor harmonics: harm = [T0, Q0, R, Omega0, a3, a6, aq, am, a1, b1, mi] (strengths applied)
+    # --- rotor harmonics: harm = [T0, Q0, R, Omega0, a3, a6, aq, am, a1, b1, mi, am_yaw, a_side]
+    #     (strengths applied). psi = 0: blade 1 up, so cos(3 psi) = -1 when a blade points down, through the
+    #     tower's shadow and the slowest wind of the shear: the collective thrust dips while the tilt moment
+    #     peaks (anti-phase); side force with the sign OpenFAST shows; yaw: see RotorHarmonics
     t0 = harm[0]
     if t0 != 0.0:
         omega = harm[3] + x[2 * nd]
@@ -218,10 +221,11 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         for a in range(3):
             u[hub0 + a] += fs * e_s[a]
             u[hub0 + 3 + a] += mq * e_s[a]
-        u[hub0 + 1] += cent * s1
+        u[rot0 + 3] += fs  # RotThrust carries the harmonic thrust too
+        u[hub0 + 1] += cent * s1 - t0 * harm[12] * c3
         u[hub0 + 2] += cent * c1
-        u[hub0 + 4] += tr * (harm[7] * c3 + harm[9] * c1)
-        u[hub0 + 5] += tr * (harm[7] * s3 + harm[9] * s1)
+        u[hub0 + 4] += tr * (-harm[7] * c3 + harm[9] * c1)
+        u[hub0 + 5] += tr * (harm[11] * s3 + harm[9] * s1)
     return domega
 
 
@@ -363,7 +367,7 @@ class Simulator:
         self.harm = np.array([
             op.thrust if op else 0.0, op.aero_torque if op else 0.0, st.data.tip_radius,
             self.system.rotor_speed, s3 * h.thrust_3p, s3 * h.thrust_6p, s3 * h.torque_3p, s3 * h.moment_3p,
-            s1 * h.thrust_1p, s1 * h.moment_1p, s1 * h.mass_imbalance,
+            s1 * h.thrust_1p, s1 * h.moment_1p, s1 * h.mass_imbalance, s3 * h.yaw_moment_3p, s3 * h.side_force_3p,
         ])
         d = st.data
         par = np.zeros(N_PAR)

@@ -10,6 +10,8 @@ from surrogates.channels import (
     ENVIRONMENT_CHANNELS,
     GAUGE_HEIGHTS,
     PLATFORM_CHANNELS,
+    ROTOR_CHANNELS,
+    TOWER_EXTRA_CHANNELS,
     UNITS,
     UnknownChannelError,
     channel_index,
@@ -70,7 +72,11 @@ def test_unknown_plane(plane):
 
 
 def test_all_channels_order():
-    assert ALL_CHANNELS == tower_channels() + PLATFORM_CHANNELS + ENVIRONMENT_CHANNELS
+    assert ALL_CHANNELS == (tower_channels() + PLATFORM_CHANNELS + ENVIRONMENT_CHANNELS + ROTOR_CHANNELS
+                            + TOWER_EXTRA_CHANNELS)
+    assert len(ALL_CHANNELS) == len(set(ALL_CHANNELS)) == 55
+    assert ROTOR_CHANNELS == ["BldPitch1", "GenTq", "GenPwr", "RotThrust"]
+    assert TOWER_EXTRA_CHANNELS == ["TwrBsMxt", "TwrBsMyt", "YawBrTAxp", "YawBrTAyp", "TTDspFA", "TTDspSS"]
     assert PLATFORM_CHANNELS == ["PtfmSurge", "PtfmSway", "PtfmHeave", "PtfmRoll", "PtfmPitch", "PtfmYaw"]
     assert ENVIRONMENT_CHANNELS == ["RotSpeed", "Wave1Elev", "Wind1VelX"]
 

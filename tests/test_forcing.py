@@ -43,10 +43,11 @@ def test_dispersion_limits_and_residual():
 
 
 def test_surge_excitation_of_uniform_deep_cylinder_matches_closed_form():
-    """Uniform cylinder of draft T in deep water: F = rho (1+Ca) A w^2 int_{-T}^0 e^{kz} dz = ... (1-e^{-kT})/k."""
+    """Uniform cylinder of draft T in deep water: F = rho (1+Ca) A w^2 int_{-T}^0 e^{kz} dz = ... (1-e^{-kT})/k
+    (Morison; diffraction off -- MacCamy-Fuchs is checked against its closed form in test_waves.py)."""
     geo = SparGeometry(upper_diameter=9.4, lower_diameter=9.4, taper_top=-4.0, taper_bottom=-12.0)
     f = np.array([0.05, 0.1, 0.2])
-    rao = excitation_rao(f, 0.0, depth=5000.0, geometry=geo, n_strips=4000)
+    rao = excitation_rao(f, 0.0, depth=5000.0, geometry=geo, n_strips=4000, diffraction=False)
     w = 2 * np.pi * f
     k = w**2 / GRAVITY
     area = np.pi * 9.4**2 / 4

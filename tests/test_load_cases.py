@@ -54,7 +54,7 @@ def test_abaei_table_1_values(n):
     case = load_case(n)
     assert (case.hs, case.tp, case.wave_dir_deg) == (hs, tp, direction)
     assert case.wind_speed == 12.0
-    assert case.rotor_rpm == 12.1
+    assert case.rotor_rpm == pytest.approx(12.1, abs=0.01)  # NREL 5 MW rated speed (Jonkman 2009, table 1-1)
     assert case.name == f"OLC{n}"
     assert LOAD_CASES[n] == case
 

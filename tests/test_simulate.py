@@ -37,14 +37,20 @@ def test_rated_wind_run_is_oc3_like(olc7_20min):
     assert 2.0 < rec["PtfmPitch"].mean() < 8.0
     base_moment = rec["TwHt1MLyt"].mean() / 1e3  # kN m -> MN m
     assert 40.0 < base_moment < 120.0
-    assert rec["RotSpeed"].mean() == pytest.approx(12.1, abs=0.2)
+    # In turbulent wind at a rated mean the rotor dips below rated speed (12.1 rpm) in the lulls and the pitch
+    # controller holds it at rated in the gusts: the mean lies a little below rated (the shared OpenFAST 12 m/s
+    # NTM run: 11.72 rpm).
+    assert 11.4 < rec["RotSpeed"].mean() < 12.15
 
 
-def test_3p_line_in_side_to_side_tower_top_acceleration(olc7_20min):
-    """Blade passing dominates the SS tower-top acceleration around 3P. In turbulent wind the line is as wide as
-    the rotor-speed variation (its azimuth follows the actual rotor speed); in steady wind it is sharp (below)."""
+def test_3p_band_in_side_to_side_tower_top_acceleration(olc7_20min):
+    """Blade passing (``rotor_3p``) and the blades' rotational sampling of the turbulence (``rotor_asymmetry``)
+    put the SS tower-top acceleration's energy around 3P; without both the band is nearly empty (the waves run
+    along the wind, nothing else excites side-to-side at 0.55-0.66 Hz). In turbulent wind the band is as wide as
+    the rotor-speed variation; in steady wind the line is sharp (below)."""
     rec = olc7_20min
-    no3p = surrogates.simulate(surrogates.FOWTModel().without("rotor_3p"), 7, duration=1200.0, seed=11)
+    off = surrogates.FOWTModel().with_effects(rotor_3p=0.0, rotor_asymmetry=0.0)
+    no3p = surrogates.simulate(off, 7, duration=1200.0, seed=11)
     f, p_on = welch(rec["TwHt9ALyt"] - rec["TwHt9ALyt"].mean(), fs=rec.fs, nperseg=16384)
     _, p_off = welch(no3p["TwHt9ALyt"] - no3p["TwHt9ALyt"].mean(), fs=rec.fs, nperseg=16384)
     band = (f > 0.55) & (f < 0.66)
@@ -65,33 +71,54 @@ def test_response_peaks_at_platform_pitch_and_tower_modes(olc7_20min):
     band = (f > 0.3) & (f < 1.2)
     f_peak = f[band][np.argmax(p[band])]
     assert f_peak == pytest.approx(f_tower, abs=0.03)
-    # At rated wind the closed-loop platform pitch mode is heavily damped (aerodynamic damping and the pitch
-    # controller, ~20 %), so platform pitch shows a broad low-frequency hump rather than a sharp line: nearly
-    # all of its variance lies in the platform-mode band, below the wave band.
+    # At rated wind platform pitch follows the turbulent thrust and the pitch controller, below the wave band:
+    # nearly all of its variance lies under 0.06 Hz (the shared OpenFAST 12 m/s run: 98 %).
     fp, pp = welch(rec["PtfmPitch"] - rec["PtfmPitch"].mean(), fs=rec.fs, nperseg=2**16)
-    assert modes.damping_ratios[modes.labels.index("pitch")] > 0.1
     platform = np.trapezoid(pp[(fp > 0.0) & (fp < 0.06)], fp[(fp > 0.0) & (fp < 0.06)])
     assert platform > 0.9 * np.trapezoid(pp, fp)
 
 
 # ------------------------------------------------------------------------------------- each effect alone
 def _pair(effect, case, duration=900.0, seed=5):
-    base = surrogates.FOWTModel(effects="none").with_noise(scale=0.0)
+    # effects="none" is the linearisation of the full model (the linear effects stay on): switch this one off
+    base = surrogates.FOWTModel(effects="none").with_effects(**{effect: 0.0}).with_noise(scale=0.0)
     with_eff = base.with_effects(**{effect: 1.0})
     kw = dict(duration=duration, dt=0.025, seed=seed, noise=False)
     return surrogates.simulate(base, case, **kw), surrogates.simulate(with_eff, case, **kw)
 
 
-def test_quadratic_drag_damps_platform_motion():
+def test_stochastic_linearisation_of_drag_matches_the_quadratic_drag():
+    """The linear model carries the Morison drag linearised about the load case's own stationary response
+    (Borgman's equivalent linearisation, sqrt(8/pi) sigma_r Cd per strip, iterated as RAFT does); the
+    ``quadratic_drag`` effect adds only the remainder (quadratic minus equivalent linear). Equivalent
+    linearisation matches the dissipated power for Gaussian relative velocity, so the platform's variance with
+    the full quadratic drag is close to the linear model's (within 15 %)."""
     off, on = _pair("quadratic_drag", 10)
-    assert np.std(on["PtfmPitch"]) < np.std(off["PtfmPitch"])
-    assert np.std(on["PtfmSurge"]) < np.std(off["PtfmSurge"])
+    for ch in ("PtfmPitch", "PtfmSurge"):
+        assert np.std(on[ch]) == pytest.approx(np.std(off[ch]), rel=0.15)
 
 
-def test_catenary_mooring_hardens_surge():
-    off, on = _pair("mooring_nonlinear", 7)
-    # hardening: smaller mean offset under the same mean thrust
-    assert on["PtfmSurge"].mean() < off["PtfmSurge"].mean() - 1.0
+def _openfast_steady_12():
+    from fowt_env.validation import load_reference
+
+    runs, _ = load_reference(runs=["d_steady12_Hs2p5_Tp10"])
+    return runs[0]
+
+
+def test_catenary_mooring_gives_openfasts_mean_surge():
+    """Mean surge in steady 12 m/s wind: OpenFAST (MAP++ catenary, the packaged run d_steady12_Hs2p5_Tp10)
+    23.71 m. The catenary table gets within 5 %; the linear tangent stiffness alone (41.2 kN/m) misses it by more
+    (the downwind line slackens: the system is softer than its tangent up to ~25 m). Measured: 24.4 m with the
+    table, 22.5 m with the tangent stiffness."""
+    run = _openfast_steady_12()
+    reference = run.statistics["PtfmSurge"]["mean"] if run.statistics else float(np.mean(run.record["PtfmSurge"]))
+    case = surrogates.operating_case(12.0, 2.5, 10.0, gamma=1.0, turbulence_intensity=0.0)
+    full = surrogates.FOWTModel().with_noise(scale=0.0)
+    kw = dict(duration=600.0, dt=0.025, seed=5, noise=False)
+    on = surrogates.simulate(full, case, **kw)["PtfmSurge"].mean()
+    off = surrogates.simulate(full.with_effects(mooring_nonlinear=0.0), case, **kw)["PtfmSurge"].mean()
+    assert on == pytest.approx(reference, rel=0.05)
+    assert abs(off - reference) > abs(on - reference)
 
 
 def test_aero_damping_reduces_tower_fore_aft_resonance():
@@ -122,8 +149,14 @@ def test_aero_damping_of_first_fa_mode_matches_closed_form():
 
 
 def test_gyroscopic_coupling_moves_yaw():
-    off, on = _pair("gyroscopic", 7)  # waves along the wind: yaw is excited only through the coupling
-    assert np.std(on["PtfmYaw"]) > 2.0 * np.std(off["PtfmYaw"]) + 1e-6
+    """Steady wind, waves along it, no rotor harmonics or disc-wind asymmetry: nothing but the spinning rotor's
+    gyroscopic moment (H x tower-top rotation rate) turns the pitching platform in yaw."""
+    case = surrogates.operating_case(12.0, 2.5, 10.0, gamma=1.0, turbulence_intensity=0.0)
+    base = surrogates.FOWTModel().with_effects(rotor_3p=0.0, rotor_1p=0.0, rotor_asymmetry=0.0).with_noise(scale=0.0)
+    kw = dict(duration=600.0, dt=0.025, seed=5, noise=False)
+    on = surrogates.simulate(base, case, **kw)["PtfmYaw"]
+    off = surrogates.simulate(base.with_effects(gyroscopic=0.0), case, **kw)["PtfmYaw"]
+    assert np.std(on) > 5.0 * np.std(off) + 1e-6
 
 
 def test_rotor_3p_adds_response_at_3p():
@@ -148,10 +181,12 @@ def test_p_delta_increases_tilt_and_base_moment():
 
 # --------------------------------------------------------------------------- integrator vs linearize()
 def test_linear_simulation_matches_lsim_of_linearize():
-    """The compiled integrator and scipy's lsim of ``linearize()`` agree on the same forcing."""
+    """The compiled integrator and scipy's lsim of ``linearize()`` agree on the same forcing. The blades'
+    rotational sampling of the turbulence (``rotor_asymmetry``) is azimuth-dependent, not an LTI input, and is
+    switched off here."""
     from scipy.signal import lsim
 
-    model = surrogates.FOWTModel(effects="none").with_noise(scale=0.0)
+    model = surrogates.FOWTModel(effects="none").with_effects(rotor_asymmetry=0.0).with_noise(scale=0.0)
     case = load_case(4)
     dt, seed, duration = 0.0125, 3, 200.0
     rec = surrogates.simulate(model, case, duration=duration, dt=dt, seed=seed, transient=0.0, noise=False)

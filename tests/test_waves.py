@@ -147,7 +147,7 @@ def test_surge_and_pitch_excitation_of_a_uniform_cylinder_in_deep_water():
     geo = SparGeometry(upper_diameter=9.4, lower_diameter=9.4)
     f = np.array([0.05, 0.1, 0.2, 0.4])
     depth = 10000.0  # kh > 100 for f >= 0.05 Hz
-    rao = excitation_rao(f, 0.0, depth=depth, geometry=geo)
+    rao = excitation_rao(f, 0.0, depth=depth, geometry=geo, diffraction=False)
     w = 2 * np.pi * f
     k, area, t = w**2 / G, np.pi * 9.4**2 / 4, 120.0
     fx = 1j * RHO * (1 + CA) * area * w**2 * (1 - np.exp(-k * t)) / k
@@ -156,7 +156,27 @@ def test_surge_and_pitch_excitation_of_a_uniform_cylinder_in_deep_water():
     np.testing.assert_allclose(rao[:, 4], my, rtol=1e-9)
     np.testing.assert_allclose(rao[:, [1, 3, 5]], 0.0, atol=0)
     # the midpoint rule on the drag strips converges to the same force
-    np.testing.assert_allclose(excitation_rao(f, 0.0, depth, geo, n_strips=3000)[:, 0], fx, rtol=1e-4)
+    strips = excitation_rao(f, 0.0, depth, geo, n_strips=3000, diffraction=False)
+    np.testing.assert_allclose(strips[:, 0], fx, rtol=1e-4)
+
+
+def test_maccamy_fuchs_diffraction_of_a_uniform_cylinder_in_deep_water():
+    """MacCamy & Fuchs (1954), derived here from the partial-wave expansion of the incident wave: on a vertical
+    cylinder of radius a in deep water the force per unit length is ``4 rho g e^{kz} / (k conj(H1'(ka)))``
+    per unit amplitude for eta = Re(A e^{i w t}) (H1 = J1 + i Y1, the Hankel function), so over a draft T
+    ``Fx = 4 rho g (1 - e^{-kT}) / (k^2 conj(H1'(ka)))``; for ka -> 0 it is Morison with Cm = 2."""
+    from scipy.special import h1vp
+
+    geo = SparGeometry(upper_diameter=9.4, lower_diameter=9.4, ca=1.0)
+    f = np.array([0.02, 0.1, 0.2, 0.4, 0.6])
+    depth = 20000.0
+    w = 2 * np.pi * f
+    k, t, a = w**2 / G, 120.0, 4.7
+    closed = 4 * RHO * G * (1 - np.exp(-k * t)) / (k**2 * np.conj(h1vp(1, k * a)))
+    np.testing.assert_allclose(excitation_rao(f, 0.0, depth=depth, geometry=geo)[:, 0], closed, rtol=1e-7)
+    morison = excitation_rao(f, 0.0, depth=depth, geometry=geo, diffraction=False)[:, 0]
+    assert abs(closed[0] / morison[0] - 1) < 1e-3  # long waves: Morison
+    assert abs(closed[-1]) < 0.3 * abs(morison[-1])  # ka = 0.87 * 4.7 = 4.1: diffraction cuts the load
 
 
 def test_surge_excitation_of_a_uniform_cylinder_in_finite_depth():
@@ -168,13 +188,13 @@ def test_surge_excitation_of_a_uniform_cylinder_in_finite_depth():
         k = k_brentq(w, depth)
         closed = RHO * (1 + CA) * area * w**2 * (np.sinh(k * depth) - np.sinh(k * (depth - t))) / (
             k * np.sinh(k * depth))
-        assert excitation_rao([f], 0.0, depth, geo)[0, 0] == pytest.approx(1j * closed, rel=1e-9)
+        assert excitation_rao([f], 0.0, depth, geo, diffraction=False)[0, 0] == pytest.approx(1j * closed, rel=1e-9)
 
 
 def test_oc3_surge_pitch_and_heave_excitation_against_quadrature():
     geo, depth = SparGeometry(), 320.0
     f = np.array([0.03, 0.08, 0.15])
-    rao = excitation_rao(f, 0.0, depth, geo)
+    rao = excitation_rao(f, 0.0, depth, geo, diffraction=False)
     for fi, row in zip(f, rao, strict=True):
         w = 2 * np.pi * fi
         k = k_brentq(w, depth)
