@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import copy
+
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
@@ -9,7 +11,7 @@ from gymnasium import spaces
 __all__ = ["VirtualSensorWrapper"]
 
 
-class VirtualSensorWrapper(gym.Wrapper):
+class VirtualSensorWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
     """Add ``obs["estimate"]``: the full channel vector reconstructed by a virtual sensor from the live channels.
 
     The sensor is any object with the estimator protocol ``reset()`` and ``update(y, mask) -> estimate``
@@ -17,14 +19,22 @@ class VirtualSensorWrapper(gym.Wrapper):
     Dropped channels are passed to the sensor as NaN with ``mask`` False.
 
     ``info`` gains ``estimation_error`` (estimate - truth, per channel), ``estimation_rmse_hidden`` and
-    ``estimation_rmse_live`` (over the channels that are dropped / available now, NaN when there are none).
+    ``estimation_rmse_live`` (RMS error over the channels that are dropped / available now; a key is absent at a
+    step with no such channel, so that every value is a number and equal seeds give equal ``info``).
+
+    The wrapper records its constructor arguments (``env.spec`` can be re-made with :func:`gymnasium.make`, as
+    Gymnasium's ``check_env`` does); a re-made environment gets its own deep copy of the sensor as it was when
+    this wrapper was built, never a sensor shared with this one.
 
     Parameters
     ----------
     env : gymnasium.Env
         A :class:`fowt_env.SparEnv` (possibly wrapped).
     sensor : object
-        The virtual sensor.
+        The virtual sensor (fitted). This wrapper drives this very object (its ``rejected_`` and other
+        attributes are the ones to read after an episode) unless ``copy_sensor``.
+    copy_sensor : bool
+        Drive a deep copy of ``sensor`` instead (default False).
 
     Examples
     --------
@@ -36,12 +46,14 @@ class VirtualSensorWrapper(gym.Wrapper):
     (18,)
     """
 
-    def __init__(self, env: gym.Env, sensor) -> None:
-        super().__init__(env)
+    def __init__(self, env: gym.Env, sensor: object, copy_sensor: bool = False) -> None:
         for name in ("reset", "update"):
             if not callable(getattr(sensor, name, None)):
                 raise ValueError(f"sensor must have a callable {name}() (the virtual-sensor protocol)")
-        self.sensor = sensor
+        # a spec re-made from this wrapper gets its own copy (taken now, before this env runs the sensor)
+        gym.utils.RecordConstructorArgs.__init__(self, sensor=copy.deepcopy(sensor), copy_sensor=True)
+        gym.Wrapper.__init__(self, env)
+        self.sensor = copy.deepcopy(sensor) if copy_sensor else sensor
         base = env.observation_space
         if not isinstance(base, spaces.Dict) or "sensors" not in base.spaces:
             raise ValueError("VirtualSensorWrapper needs a Dict observation space with 'sensors' and 'mask'")
@@ -64,8 +76,10 @@ class VirtualSensorWrapper(gym.Wrapper):
         err = est - truth
         est = np.clip(est, self._low, self._high)
         info["estimation_error"] = err
-        info["estimation_rmse_hidden"] = float(np.sqrt(np.mean(err[~mask] ** 2))) if (~mask).any() else float("nan")
-        info["estimation_rmse_live"] = float(np.sqrt(np.mean(err[mask] ** 2))) if mask.any() else float("nan")
+        if (~mask).any():
+            info["estimation_rmse_hidden"] = float(np.sqrt(np.mean(err[~mask] ** 2)))
+        if mask.any():
+            info["estimation_rmse_live"] = float(np.sqrt(np.mean(err[mask] ** 2)))
         self.env.unwrapped._last["estimate"] = est
         return {**obs, "estimate": est}, info
 
