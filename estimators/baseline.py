@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from .screening import FaultScreen, make_screen
-from .validation import apply_masks, as_records
+from .validation import MAX_ABS, apply_masks, as_records, as_sample
 
 __all__ = ["HoldLastValue"]
 
@@ -62,7 +62,7 @@ class HoldLastValue:
         -------
         self
         """
-        records = apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=1), mask)
+        records = apply_masks(as_records(Y, "Y", allow_nan=True, min_samples=1, max_abs=MAX_ABS), mask)
         self.screen_ = make_screen(self.screen, records)
         Y = np.concatenate(records, axis=0)
         m = np.isfinite(Y)
@@ -91,10 +91,9 @@ class HoldLastValue:
         -------
         ndarray (n_channels,)
         """
-        y = np.asarray(y, dtype=float)
-        mask = np.isfinite(y) if mask is None else np.asarray(mask, dtype=bool)
-        if y.ndim != 1 or mask.shape != y.shape:
-            raise ValueError(f"y and mask must be 1-D of the same length, got {y.shape} and {mask.shape}")
+        y, mask = as_sample(y, mask)
+        if mask is None:
+            mask = np.isfinite(y)
         if not hasattr(self, "_last"):
             self.reset()
         expected = self._last.size if self._last is not None else getattr(self, "n_channels_", None)

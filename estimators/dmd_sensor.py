@@ -38,7 +38,7 @@ import scipy.linalg as sla
 
 from .hankel_dmd import HankelDMD
 from .screening import FaultScreen, make_screen
-from .validation import MAX_ABS, apply_masks, as_2d_float, as_records, check_fitted, check_number
+from .validation import MAX_ABS, apply_masks, as_2d_float, as_records, as_sample, check_fitted, check_number
 
 __all__ = ["HankelDMDSensor"]
 
@@ -284,17 +284,8 @@ class HankelDMDSensor:
         return {"hits": self._hits, "misses": self._misses, "size": len(self._cache)}
 
     def _check_sample(self, y: object, mask: object) -> tuple[np.ndarray, np.ndarray]:
-        p = self.n_channels_
-        y = np.asarray(y, dtype=float)
-        if y.shape != (p,):
-            raise ValueError(f"y must have shape ({p},) (the {p} channels the sensor was fitted on), got {y.shape}")
-        if mask is None:
-            live = np.isfinite(y)
-        else:
-            m = np.asarray(mask)
-            if m.shape != (p,):
-                raise ValueError(f"mask must have shape ({p},), got {m.shape}")
-            live = m.astype(bool) & np.isfinite(y)
+        y, m = as_sample(y, mask, self.n_channels_)
+        live = np.isfinite(y) if m is None else m & np.isfinite(y)
         return y, live
 
     def _solver(self, live_rows: np.ndarray) -> tuple[np.ndarray, tuple]:

@@ -54,7 +54,7 @@ from scipy.signal import lfilter
 
 from .intervals import calibration_terms, model_error_std, unmeasured_std
 from .screening import FaultScreen, make_screen
-from .validation import MAX_ABS, as_2d_float
+from .validation import MAX_ABS, as_2d_float, as_sample
 
 __all__ = ["KalmanSensor"]
 
@@ -778,17 +778,8 @@ class KalmanSensor:
         self._check_fitted()
         if not hasattr(self, "_x"):
             self.reset()
-        y = np.asarray(y, dtype=float)
-        n_ch = self.n_channels_
-        if y.shape != (n_ch,):
-            raise ValueError(f"y must have shape ({n_ch},) (one value per model output), got {y.shape}")
-        if mask is None:
-            live = np.isfinite(y)
-        else:
-            mask = np.asarray(mask)
-            if mask.shape != (n_ch,):
-                raise ValueError(f"mask must have shape ({n_ch},) like y, got {mask.shape}")
-            live = mask.astype(bool) & np.isfinite(y)
+        y, mask = as_sample(y, mask, self.n_channels_)
+        live = np.isfinite(y) if mask is None else mask & np.isfinite(y)
         live = self.screen_.screen(np.where(np.isfinite(y), y, np.nan), live)
         self.gated_counts_ += self.screen_.rejected_
         uk = None

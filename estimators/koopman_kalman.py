@@ -91,7 +91,16 @@ from scipy.signal import lfilter
 from .hankel_dmd import HankelDMD
 from .intervals import calibration_terms, model_error_std, unmeasured_std
 from .screening import FaultScreen, make_screen
-from .validation import MAX_ABS, NotFittedError, apply_masks, as_records, check_int, check_number, split_at_nonfinite
+from .validation import (
+    MAX_ABS,
+    NotFittedError,
+    apply_masks,
+    as_records,
+    as_sample,
+    check_int,
+    check_number,
+    split_at_nonfinite,
+)
 
 __all__ = ["KoopmanKalmanSensor"]
 
@@ -655,20 +664,8 @@ class KoopmanKalmanSensor:
         self._check_fitted()
         if not hasattr(self, "_x"):
             self.reset()
-        n_ch = self.n_channels_
-        try:
-            y = np.asarray(y, dtype=float)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"y must be a numeric array of shape ({n_ch},), got {type(y).__name__}") from exc
-        if y.shape != (n_ch,):
-            raise ValueError(f"y must have shape ({n_ch},) (one value per channel seen in fit), got {y.shape}")
-        if mask is None:
-            live = np.isfinite(y)
-        else:
-            mask = np.asarray(mask)
-            if mask.shape != (n_ch,):
-                raise ValueError(f"mask must have shape ({n_ch},) like y, got {mask.shape}")
-            live = mask.astype(bool) & ~np.isnan(y)
+        y, mask = as_sample(y, mask, self.n_channels_)
+        live = np.isfinite(y) if mask is None else mask & ~np.isnan(y)
         if np.isinf(y[live]).any():
             raise ValueError(f"y holds ±inf in live channel(s) {np.flatnonzero(live & np.isinf(y)).tolist()}")
         return self._step(y, live, return_std)

@@ -964,6 +964,10 @@ def lyapunov_exponent(
     """
     dt = _check_dt(dt)
     x = _as_signal(x, min_samples=16)
+    # the exponent does not depend on the unit or the offset: work on a standardised copy, so that squared
+    # distances of 1e-160-sized (or 1e+150-sized) data neither underflow to 0 nor overflow
+    x = x / np.max(np.abs(x))
+    x = (x - x.mean()) / x.std()
     # cheap checks first, before any embedding search
     lag = None if lag is None else check_int("lag (samples)", lag, minimum=1)
     dim = None if dim is None else check_int("dim", dim, minimum=1)
@@ -992,6 +996,13 @@ def lyapunov_exponent(
     if fit_range is not None:
         a, b = _check_fit_range(fit_range, max_steps, dt)
     divergence, n_pairs = _divergence_curve(x, dim, lag, max_steps, theiler)
+    lost = np.flatnonzero(~np.isfinite(divergence))
+    if lost.size:
+        raise ValueError(
+            f"x repeats itself exactly: after {int(lost[0])} step(s) every followed pair of neighbours lands on an "
+            "exact repeat (zero distance), so the divergence curve is undefined there (a signal that is constant "
+            "but for a few samples, or quantized to a few levels)"
+        )
     diagnostic = ""
     if fit_range is None:
         a, b, diagnostic = _auto_fit_window(divergence)

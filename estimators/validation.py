@@ -17,6 +17,7 @@ __all__ = [
     "apply_masks",
     "as_2d_float",
     "as_records",
+    "as_sample",
     "check_fitted",
     "check_int",
     "check_no_constant_channels",
@@ -386,3 +387,57 @@ def apply_masks(records: list[np.ndarray], mask: object) -> list[np.ndarray]:
             raise ValueError(f"mask: record {i} needs shape {rec.shape} or ({rec.shape[1]},), got {m.shape}")
         out.append(np.where(np.broadcast_to(m.astype(bool), rec.shape), rec, np.nan))
     return out
+
+
+def as_sample(y: object, mask: object = None, n_channels: int | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+    """One streamed sample and its mask checked the same way by every virtual sensor's ``update``.
+
+    Parameters
+    ----------
+    y : array_like (n_channels,)
+        Real numbers; NaN (a lost sample) and any finite magnitude are allowed (the fault screen judges values).
+    mask : array_like (n_channels,), optional
+        Booleans, or the integers 0/1; True = available.
+    n_channels : int, optional
+        Expected length (the channels the sensor was fitted on); None: any 1-D length.
+
+    Returns
+    -------
+    y : ndarray of float (n_channels,)
+        A new array.
+    mask : ndarray of bool (n_channels,) or None
+
+    Raises
+    ------
+    TypeError
+        ``y`` complex (its imaginary part would be dropped) or not numbers, ``mask`` not booleans.
+    ValueError
+        Wrong shapes, or a mask with values other than True/False/0/1.
+    """
+    arr = np.asarray(y)
+    if np.iscomplexobj(arr):
+        raise TypeError("y must be real; got complex values (their imaginary part would be dropped)")
+    if arr.dtype.kind not in "biuf":
+        try:
+            arr = np.asarray(arr, dtype=float)
+        except (TypeError, ValueError):
+            raise TypeError(f"y must hold real numbers, got an array of {arr.dtype} "
+                            f"({type(y).__name__})") from None
+    expected = "(n_channels,)" if n_channels is None else f"({n_channels},)"
+    if arr.ndim != 1 or (n_channels is not None and arr.shape[0] != n_channels):
+        raise ValueError(f"y must have shape {expected} (one value per channel), got {arr.shape}")
+    out = np.array(arr, dtype=float)
+    if mask is None:
+        return out, None
+    m = np.asarray(mask)
+    if m.shape != out.shape:
+        raise ValueError(f"mask must have shape {out.shape} like y, got {m.shape}")
+    if m.dtype.kind != "b":
+        if m.dtype.kind not in "iuf" or np.iscomplexobj(m):
+            raise TypeError(f"mask must hold booleans (True = available), got an array of {m.dtype}")
+        with np.errstate(invalid="ignore"):
+            odd = ~((m == 0) | (m == 1))
+        if odd.any():
+            raise ValueError(f"mask must hold booleans or 0/1 (True = available); got {m[odd][0].item()!r} at channel "
+                             f"{int(np.flatnonzero(odd)[0])}")
+    return out, m.astype(bool)

@@ -232,7 +232,15 @@ class SparEnv(gym.Env):
         return {"sensors": sensors, "mask": mask.astype(np.int8)}
 
     def _physical_action(self, action) -> np.ndarray:
-        a = np.asarray(action, dtype=float)
+        raw = np.asarray(action)
+        shown = " ".join(repr(action).split())  # one line, whatever the action's repr
+        shown = shown if len(shown) <= 80 else shown[:77] + "..."
+        if np.iscomplexobj(raw):
+            raise TypeError(f"action must be real [pitch, torque] in [-1, 1], got complex values: {shown}")
+        try:
+            a = np.asarray(raw, dtype=float)
+        except (TypeError, ValueError):
+            raise TypeError(f"action must be two real numbers [pitch, torque] in [-1, 1], got {shown}") from None
         if a.shape != (2,):
             raise ValueError(f"action must have shape (2,) [pitch, torque], got {a.shape}")
         a0, a1 = float(a[0]), float(a[1])

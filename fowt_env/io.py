@@ -68,6 +68,7 @@ import stat
 import uuid
 import warnings
 import zipfile
+import zlib
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -1421,8 +1422,8 @@ def load_record(
     if ext == ".npz":
         try:
             record = Record.load(p)
-        except (ValueError, OSError, EOFError, KeyError, zipfile.BadZipFile) as exc:
-            message = str(exc)
+        except (ValueError, OSError, EOFError, KeyError, zipfile.BadZipFile, zlib.error) as exc:
+            message = str(exc) if not isinstance(exc, zlib.error) else f"corrupt compressed data ({exc})"
             message = message[len(str(p)):].lstrip(": ") if message.startswith(str(p)) else message
             raise RecordFileError(p, message or type(exc).__name__) from None
         try:  # Record allows any increasing t; every reader here promises a uniform grid
