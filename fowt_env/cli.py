@@ -176,6 +176,36 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     path = _save_record(rec, args.out)
     print(f"wrote {path}: {rec.n_samples} samples x {rec.n_channels} channels, {rec.duration:.1f} s simulated "
           f"in {wall:.2f} s ({rec.duration / max(wall, 1e-9):.0f}x real time)")
+    from .validation import DEL_CHANNELS, record_dels
+
+    base = [c for c in DEL_CHANNELS if c in rec.channels]
+    if base:
+        dels = record_dels(rec, base)
+        print("tower-base DELs (rainflow, m = 4, 1 Hz; fowt-env fatigue for more): "
+              + ", ".join(f"{c} {v:,.0f} {rec.units[rec.channels.index(c)]}" for c, v in dels.items()))
+    return 0
+
+
+def _cmd_fatigue(args: argparse.Namespace) -> int:
+    from .validation import record_dels
+
+    rec = _load_record(args.record, args.channel_map)
+    channels = args.channels.split(",") if args.channels else None
+    if not (args.m > 0 and args.frequency > 0):
+        raise _UsageError(f"--m and --frequency must be > 0, got {args.m} and {args.frequency}")
+    dels = record_dels(rec, channels, m=args.m, frequency_hz=args.frequency)
+    units = dict(zip(rec.channels, rec.units, strict=True))
+    print(f"damage-equivalent loads of {args.record}: rainflow (ASTM E1049-85), Woehler m = {args.m:g}, "
+          f"N_eq = {args.frequency:g} Hz x {rec.t[-1] - rec.t[0]:.1f} s")
+    width = max(len(c) for c in dels)
+    for c, v in dels.items():
+        print(f"  {c:<{width}}  {v:14.6g} {units.get(c, '')}")
+    if args.json:
+        payload = {"record": str(args.record), "m": args.m, "frequency_hz": args.frequency,
+                   "duration_s": float(rec.t[-1] - rec.t[0]),
+                   "dels": {c: {"del": v, "unit": units.get(c, "")} for c, v in dels.items()}}
+        Path(args.json).write_text(json.dumps(payload, indent=2))
+        print(f"wrote {args.json}")
     return 0
 
 
@@ -832,6 +862,18 @@ def build_parser() -> argparse.ArgumentParser:
     vd.add_argument("--all-channels", action="store_true", help="list every compared channel, not only graded ones")
     vd.add_argument("--strict", action="store_true", help="exit with status 1 if a graded check fails")
     vd.set_defaults(func=_cmd_validate)
+
+    f = sub.add_parser("fatigue", help="damage-equivalent loads (rainflow) of a record's tower moments")
+    f.add_argument("record", help="record file: .npz (fowt-env), OpenFAST .out/.outb, or .csv/.parquet field data")
+    f.add_argument("--channels", default=None,
+                   help="comma-separated channels (default: the tower moments, TwrBsMyt/TwrBsMxt and TwHt*MLyt/MLxt)")
+    f.add_argument("--m", type=float, default=4.0, help="Woehler exponent of the S-N curve (default 4)")
+    f.add_argument("--frequency", type=float, default=1.0,
+                   help="frequency of the equivalent load in Hz: N_eq = frequency x record length (default 1)")
+    f.add_argument("--channel-map", default=None, metavar="FILE.json",
+                   help='JSON object renaming file columns to channel names, e.g. {"mb_fa": "TwrBsMyt"}')
+    f.add_argument("--json", default=None, help="write the DELs as JSON")
+    f.set_defaults(func=_cmd_fatigue)
 
     m = sub.add_parser("modes", help="modal frequencies and damping of the linearised model")
     m.add_argument("--case", default=None, help="OLC number (default: parked, still water)")

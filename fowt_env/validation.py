@@ -34,6 +34,7 @@ import inspect
 import json
 import math
 import os
+import re
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -62,6 +63,7 @@ __all__ = [
     "mean_tolerance",
     "packaged_reference_dir",
     "psd",
+    "record_dels",
     "record_statistics",
     "spread_tolerance",
     "surrogate_case",
@@ -242,6 +244,61 @@ def damage_equivalent_load(x: ArrayLike, *, duration: float, m: float = WOHLER_S
     for rng, _mean, count, _i0, _i1 in rainflow.extract_cycles(arr):
         damage += count * rng**m
     return float((damage / (frequency_hz * duration)) ** (1.0 / m))
+
+
+_MOMENT_CHANNEL = re.compile(r"^(TwrBsM[xy]t|TwHt\d+ML[xy]t)$")
+
+
+def record_dels(record: Any, channels: Sequence[str] | None = None, *, m: float = WOHLER_SLOPE,
+                frequency_hz: float = DEL_FREQUENCY_HZ) -> dict[str, float]:
+    """Damage-equivalent loads of a record's channels (:func:`damage_equivalent_load` per channel).
+
+    Parameters
+    ----------
+    record : surrogates.Record
+        Any record (simulated, OpenFAST, field data); ``N_eq = frequency_hz * (t[-1] - t[0])``.
+    channels : sequence of str, optional
+        Channels to evaluate. Default: the tower moments it has, the tower-base ones (:data:`DEL_CHANNELS`)
+        and every gauge moment ``TwHt{i}MLyt`` / ``TwHt{i}MLxt``.
+    m : float
+        Wöhler exponent (-); default 4.
+    frequency_hz : float
+        Frequency of the equivalent load (Hz); default 1.
+
+    Returns
+    -------
+    dict of str to float
+        Channel -> DEL, in the channel's own unit (peak to peak; kN·m for OpenFAST's moments), in record order.
+
+    Raises
+    ------
+    ValueError
+        A requested channel the record lacks, no moment channel to default to, or bad ``m``/``frequency_hz``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from surrogates import Record
+    >>> t = np.linspace(0.0, 100.0, 10001)
+    >>> rec = Record(t, 500.0 * np.cos(2 * np.pi * t)[:, None], ["TwrBsMyt"], ["kN-m"])
+    >>> round(record_dels(rec)["TwrBsMyt"], 1)   # 100 cycles of a 1 Hz sine of amplitude 500: its range
+    1000.0
+    """
+    names = list(record.channels)
+    if channels is None:
+        chosen = [c for c in names if _MOMENT_CHANNEL.match(c)]
+        if not chosen:
+            raise ValueError("the record has no tower moment channel (TwrBsMyt/TwrBsMxt, TwHt{i}MLyt/MLxt): "
+                             "name the channels to evaluate")
+    else:
+        chosen = list(channels)
+        missing = [c for c in chosen if c not in names]
+        if missing:
+            raise ValueError(f"channels: not in the record: {missing}")
+    t = np.asarray(record.t, dtype=float)
+    duration = float(t[-1] - t[0])
+    return {c: damage_equivalent_load(record[c], duration=duration, m=m, frequency_hz=frequency_hz)
+            for c in chosen}
 
 
 @dataclass(frozen=True)
