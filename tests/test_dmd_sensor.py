@@ -212,6 +212,10 @@ def test_spikes_and_a_stuck_sensor_are_gated(spar):
     y_stuck[800:, 4] = y[800, 4]  # gauge-5 accelerometer frozen from t = 10 s, still reported available
     stuck = r2_score(truth, sensor.reconstruct(y_stuck, mask))[hidden]
     assert sensor.screen_.counts_["spike"].sum() + sensor.screen_.counts_["range"].sum() == 0  # (stuck run last)
+    assert sensor.screen_.counts_["flat"][4] > 0.9 * (y.shape[0] - 800)  # the frozen channel is screened out
+    lost = mask.copy()
+    lost[800:, 4] = False  # what the stuck sensor may cost at most: the channel itself, lost from t = 10 s
+    without = r2_score(truth, sensor.reconstruct(y, lost))[hidden]
     sensor.gate_sigma = None
     sensor.screen_.active = False  # neither the gate nor the shared fault screen
     try:
@@ -220,8 +224,11 @@ def test_spikes_and_a_stuck_sensor_are_gated(spar):
         sensor.gate_sigma = 8.0
         sensor.screen_.active = True
     print(f"\nDMD sensor: hidden R2 clean {np.round(clean, 4)}, spikes gated {np.round(gated, 4)}, ungated "
-          f"{np.round(ungated, 4)}, stuck sensor {np.round(stuck, 4)}")
-    assert np.all(gated > clean - 0.005) and np.all(stuck > clean - 0.01)
+          f"{np.round(ungated, 4)}, stuck sensor {np.round(stuck, 4)}, channel 4 lost {np.round(without, 4)}")
+    # Was: stuck > clean - 0.01. Since the rotor's tilt moment from rotationally sampled turbulence drives the
+    # nacelle moment (channel 17, clean R2 0.760), losing the gauge-5 accelerometer itself costs it 0.011 (0.7496);
+    # the stuck run gives 0.7495: the screen costs nothing beyond losing the channel.
+    assert np.all(gated > clean - 0.005) and np.all(stuck > without - 0.002) and np.all(stuck > clean - 0.03)
     assert np.all(ungated < gated - 0.1)
 
 
