@@ -429,6 +429,9 @@ class FOWTModel:
         f_x += np.outer(h_v, t_x) + np.outer(r_s, qg_x)
         f_u += np.outer(h_v, t_u) + np.outer(r_s, qg_u)
         f_u[:, 0] += st.gravity_load + h_v * t0 + r_s * qg0
+        # the mean thrust follows the rotor axis as the tower top pitches (theta about y turns e_s by e_y x e_s):
+        # the platform's set-down and heave-pitch coupling under thrust (the simulation's rotor does the same)
+        f_x[:, :N_DOF] += t0 * np.outer(j_hub.T @ np.cross([0.0, 1.0, 0.0], e_s), r_tt[1])
         f_u[:6, INPUT_BLOCKS["wave"]] += np.eye(6)
         hub = INPUT_BLOCKS["hub"]
         f_u[:, hub.start:hub.start + 3] += j_hub.T

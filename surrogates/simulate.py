@@ -197,8 +197,14 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         q_gen = par[P_NGEAR] * q_gen_hss
         domega = (q_aero - q_gen) / par[P_J]
         reaction = q_gen + par[P_JREACT] * domega  # torque the drivetrain puts on the nacelle about the shaft
+        # the thrust acts along the rotor axis, which turns with the tower top (a follower force): pitching
+        # forward by theta tips it down by theta (e_y x e_s), the platform's set-down under thrust
+        e_follow_x = e_s[0] + theta * e_s[2]
+        e_follow_z = e_s[2] - theta * e_s[0]
+        u[hub0 + 0] += thrust * e_follow_x
+        u[hub0 + 1] += thrust * e_s[1]
+        u[hub0 + 2] += thrust * e_follow_z
         for a in range(3):
-            u[hub0 + a] += thrust * e_s[a]
             u[hub0 + 3 + a] += reaction * e_s[a]
         u[rot0 + 0] = pitch
         u[rot0 + 1] = q_gen_hss
