@@ -15,10 +15,13 @@ identical, every difference is the effect itself, not sampling scatter. A band t
 change by 30 dB and not matter, so besides the change in dB the script reports it as a share of the channel's
 variance, and "largest change" is measured that way.
 
-What to look for (default ``rotor_3p``): the 3P (0.6 Hz) and 6P (1.2 Hz) bands gain 15-20 dB, the blade-passing
-harmonics -- broad bands rather than lines, because the rotor speed wanders by a couple of rpm in turbulence --
-and the most energy is added at the 1st tower mode just below 3P, which the wandering 3P forcing drives
-resonantly. Nothing changes below 0.3 Hz. Try the others::
+What to look for (default ``rotor_3p``, amplitudes measured on OpenFAST's OC3 Hywind in steady wind): the
+side-to-side tower-base moment gains ~20 dB at 3P (the blades' in-plane forces and the yaw moment no longer
+cancel when one blade passes the tower) and ~8 dB at the 1st tower mode just below 3P, which the wandering 3P
+forcing drives resonantly (broad bands rather than lines: the rotor speed wanders by a couple of rpm in
+turbulence); the fore-aft base moment gains ~5 dB at 3P and the tower-top accelerometer ~6 dB at 6P but almost
+nothing at 3P, because the thrust dip and the tilt moment of the blade passing the tower push the tower top in
+opposite directions (OpenFAST shows them in anti-phase). Nothing changes below 0.3 Hz. Try the others::
 
     --effect aero_damping       the 1st fore-aft tower peak drops by ~4 dB and the slow platform motion seen by the
                                 tower-top accelerometer shrinks (damping); side-to-side does not change

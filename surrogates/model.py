@@ -443,6 +443,13 @@ class FOWTModel:
         sh = INPUT_BLOCKS["shear"]
         for col, (force, moment) in zip(range(sh.start, sh.stop), shear_loads, strict=True):
             f_u[:, col] += j_hub.T @ force + r_tt.T @ moment
+        # the rotor's aerodynamic damping of tilt and yaw: a disc turning at (pitch rate, yaw rate) meets the
+        # relative-wind gradients dU/dy = +yaw rate, dU/dz = -pitch rate, loaded as any disc gradient (the
+        # simulation's nonlinear rotor does the same blade by blade)
+        rate_rows = (r_tt[2], -r_tt[1])
+        motion_loads = _shear_hub_loads(op, st.data.tip_radius, 0.0 if nonlinear_rotor else s_aero)
+        for rows, (force, moment) in zip(rate_rows, motion_loads, strict=True):
+            f_x[:, N_DOF:2 * N_DOF] += np.outer(j_hub.T @ force + r_tt.T @ moment, rows)
         # tower drag: generalised force per unit V|V| of the hub wind
         itd = INPUT_BLOCKS["rotor"].start + 4
         twr_z, twr_f = _tower_drag_strips(st.data.tower_base_height, st.data.tower_top_height, eff["tower_drag"])
@@ -525,6 +532,8 @@ class FOWTModel:
             mom_u[:, hub.start + 3:hub.stop] += np.eye(3)
             for col, (force, moment) in zip(range(sh.start, sh.stop), shear_loads, strict=True):
                 mom_u[:, col] += lever_hub @ force + moment
+            for rows, (force, moment) in zip(rate_rows, motion_loads, strict=True):
+                mom_x[:, N_DOF:2 * N_DOF] += np.outer(lever_hub @ force + moment, rows)
             for z_s, f_s in zip(twr_z, twr_f, strict=True):
                 if z_s > h:
                     mom_u[1, itd] += (z_s - h) * f_s

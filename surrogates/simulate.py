@@ -30,7 +30,16 @@ from .controller import DISCON, N_CONTROLLER_STATE, discon_step, initial_control
 from .controller import PARAMS as DISCON_PARAMS
 from .drag import N_STRIPS, drag_strips
 from .load_cases import LoadCase
-from .model import INPUT_BLOCKS, N_INPUT, N_STATE, FOWTModel, LinearSystem, _as_case, blade_load_radii
+from .model import (
+    BLADE_SAMPLING_RADIUS,
+    INPUT_BLOCKS,
+    N_INPUT,
+    N_STATE,
+    FOWTModel,
+    LinearSystem,
+    _as_case,
+    blade_load_radii,
+)
 from .mooring import mooring_loads, mooring_table
 from .oc3 import RHO_AIR
 from .record import Record
@@ -65,8 +74,8 @@ _INITIAL_CHANNELS = (*_PLATFORM_DOF, "TTDspFA", "TTDspSS", "RotSpeed")
 # ------------------------------------------------------------------------------------------------ kernel
 # scalar parameters of the kernel, packed in one float array ``par``
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
-    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_RQ = range(20)
-N_PAR = 20
+    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_RQ, P_RS = range(21)
+N_PAR = 21
 FIELD_DT = 0.05
 """Time step (s) of the synthesised turbulent field over the rotor disc."""
 N_BLADE_AZIMUTH = 24
@@ -148,9 +157,13 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
     if par[P_ROTOR] > 0.0:
         v_hub = 0.0
         theta = 0.0
+        rate_y = 0.0  # tower-top pitch and yaw rates (rad/s); r_pitch holds the pitch row, then the yaw row
+        rate_z = 0.0
         for i in range(nd):
             v_hub += h_v[i] * x[nd + i]
             theta += r_pitch[i] * x[i]
+            rate_y += r_pitch[i] * x[nd + i]
+            rate_z += r_pitch[nd + i] * x[nd + i]
         wind = u_ex[k, I_WIND] + par[P_V0]
         vn = wind * math.cos(par[P_TILT] - theta) - par[P_SAERO] * v_hub  # shaft elevation: tilt - pitch
         omega = par[P_OMEGA0] + x[2 * nd]
@@ -162,29 +175,36 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         q_aero = qdyn * par[P_RADIUS] * cq
         # rotationally sampled turbulence: each blade's wind departs from the disc mean; linear blade loads give
         # the rotor's tilt/yaw moments, in-plane force and the 3P-band thrust and torque
+        # and the disc's own tilt and yaw rates: a point (y, z) of the disc moves downwind at rate_y z - rate_z y,
+        # so the blades meet a relative-wind gradient (-rate_y over z, +rate_z over y): the rotor's aerodynamic
+        # damping of tilt and yaw (aero_damping)
         s_asym = par[P_SASYM]
-        if s_asym > 0.0 and blade.shape[0] > k:
-            n_az = blade.shape[1]
-            d_az = 2.0 * math.pi / n_az
+        s_rot = par[P_SAERO] if par[P_RS] > 0.0 else 0.0
+        has_field = s_asym > 0.0 and blade.shape[0] > k
+        if has_field or s_rot > 0.0:
             mt = 0.0
             my = 0.0
             fy = 0.0
             fz = 0.0
             for b in range(3):
                 psi_b = psi + b * 2.0 * math.pi / 3.0
-                phi = (-psi_b) % (2.0 * math.pi)  # the blade's azimuth from the top towards +y
-                fa = phi / d_az
-                i0 = int(fa) % n_az
-                i1 = (i0 + 1) % n_az
-                wa = fa - int(fa)
-                v_b = (1.0 - wa) * blade[k, i0] + wa * blade[k, i1]
-                dv = s_asym * (v_b - wind)
+                c_b = math.cos(psi_b)
+                s_b = math.sin(psi_b)
+                dv = -s_rot * (rate_y * par[P_RS] * c_b + rate_z * par[P_RS] * s_b)  # blade at r_s (-sin, cos)
+                if has_field:
+                    n_az = blade.shape[1]
+                    d_az = 2.0 * math.pi / n_az
+                    phi = (-psi_b) % (2.0 * math.pi)  # the blade's azimuth from the top towards +y
+                    fa = phi / d_az
+                    i0 = int(fa) % n_az
+                    i1 = (i0 + 1) % n_az
+                    wa = fa - int(fa)
+                    v_b = (1.0 - wa) * blade[k, i0] + wa * blade[k, i1]
+                    dv += s_asym * (v_b - wind)
                 d_t = par[P_DTDU] / 3.0 * dv
                 d_q = par[P_DQDU] / 3.0 * dv
                 thrust += d_t
                 q_aero += d_q
-                c_b = math.cos(psi_b)
-                s_b = math.sin(psi_b)
                 mt += d_t * par[P_RT] * c_b  # blade at (y, z) = r (-sin, cos): tilt = z F
                 my += d_t * par[P_RT] * s_b  # yaw = -y F
                 fy += -d_q / par[P_RQ] * c_b  # in-plane force along the direction of rotation
@@ -363,7 +383,8 @@ class Simulator:
         self.moor_g0, self.moor_jac = self._mooring_linearisation(zf)
         self.e_s = np.ascontiguousarray(st.shaft_axis, dtype=float)
         self.h_v = np.ascontiguousarray(st.shaft_axis @ st.hub_translation, dtype=float)
-        self.r_pitch = np.ascontiguousarray(st.tower_top_rotation[1], dtype=float)
+        self.r_pitch = np.ascontiguousarray(np.concatenate([st.tower_top_rotation[1], st.tower_top_rotation[2]]),
+                                            dtype=float)  # tower-top pitch row, then yaw row
         rt = rotor_table()
         self.rotor_grids = (np.ascontiguousarray(rt.tsr, dtype=float), np.ascontiguousarray(rt.pitch_rad, dtype=float),
                             np.ascontiguousarray(rt.ct, dtype=float), np.ascontiguousarray(rt.cq, dtype=float))
@@ -396,6 +417,7 @@ class Simulator:
             par[P_SASYM] = float(eff["rotor_asymmetry"])
             par[P_DTDU], par[P_DQDU] = op.dT_dV, op.dQ_dV
             par[P_RT], par[P_RQ] = blade_load_radii(rt.radius)
+            par[P_RS] = BLADE_SAMPLING_RADIUS * rt.radius
         self.par = par
         self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
         if op is not None:

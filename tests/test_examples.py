@@ -121,9 +121,15 @@ def test_02_modes_are_the_models_and_near_the_oc3_reference(lesson):
 def test_03_blade_passing_adds_energy_at_3p_and_6p_only(lesson):
     _, r, _ = lesson("03")
     assert r["effect"] == "rotor_3p"
-    db = r["band_change_db"]["TwHt9ALxt"]
-    assert db["3P"] > 3.0 and db["6P"] > 3.0
-    assert abs(db["platform"]) < 0.5 and abs(db["waves"]) < 0.5
+    # the 3P loads are OpenFAST's (RotorHarmonics): the side force and yaw moment show in the side-to-side base
+    # moment, the thrust ripple in the fore-aft base moment; at the tower top the thrust dip and the tilt moment
+    # (anti-phase) nearly cancel at 3P, the 6P thrust remains
+    change = r["band_change_db"]
+    assert change["TwHt1MLxt"]["3P"] > 10.0
+    assert change["TwHt1MLyt"]["3P"] > 2.0
+    assert change["TwHt9ALxt"]["6P"] > 3.0
+    for ch in ("TwHt9ALxt", "TwHt1MLyt", "TwHt1MLxt"):
+        assert abs(change[ch]["platform"]) < 0.5 and abs(change[ch]["waves"]) < 0.5
 
 
 def test_04_dropouts_follow_the_configured_rate_and_never_touch_the_truth(lesson):
