@@ -5,9 +5,13 @@ particle velocity minus the platform's). A linear model of the floating turbine 
 statistical linearisation (Borgman 1967; what frequency-domain FOWT tools such as RAFT use): for Gaussian
 relative velocity along the wave direction with standard deviation ``sigma``, the equivalent linear
 coefficient is ``sqrt(8/pi) sigma`` along that direction and ``sqrt(2/pi) sigma`` (``E|u_along|``) across it.
-Here ``sigma(z)`` is the wave-particle velocity's, from the JONSWAP spectrum through linear (Airy) kinematics
-at the strip's depth; the platform's own velocity is left out (no iteration), which makes the linear damping
-slightly low.
+The surrogate's linear model (``surrogates.model``, ``_stochastic_drag``) takes ``sigma(z)`` as the std of the
+*relative* velocity and iterates it with the linear model's own stationary response to the sea state and the
+rotor-effective turbulence, as RAFT does (``with_relative_velocity_std`` builds the strips for each iterate).
+The functions here that take only a sea state (``drag_strips``, ``equivalent_drag_damping``) use the
+wave-particle velocity's ``sigma(z)`` alone, from the JONSWAP spectrum through linear (Airy) kinematics at the
+strip's depth, without the platform's own velocity -- the value the iteration starts from, not the one the
+surrogate uses.
 
 The split used by the surrogate: the linear model carries the equivalent damping (and the equivalent drag
 excitation ``B_eq u_wave``), and the ``quadratic_drag`` effect carries the remainder ``|u_r| u_r`` minus its
