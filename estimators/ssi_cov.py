@@ -206,6 +206,8 @@ class SSICov:
         sqrt(1 - zeta^2)``.
     n_stable_ : ndarray (n_modes,) of int
         Number of orders at which each mode has a stable pole.
+    min_stable_ : int
+        Orders at which a cluster of stable poles had to hold one to count as a mode (``min_stable`` resolved).
     harmonics_ : list of dict
         Forced harmonic lines, ascending in frequency: ``frequency_hz``, ``damping_ratio`` (medians; near zero),
         ``n_stable`` (orders at which the line is present), ``shape`` (``p`` complex, normalised),
@@ -216,8 +218,11 @@ class SSICov:
         ``stable_frequency``, ``stable_damping``, ``stable_mode`` (each criterion against the lower order;
         all False at the lowest order), ``stable`` (all three and ``harmonic_damping <= zeta < max_damping``) and
         ``harmonic`` (frequency and shape stable, ``|zeta| < harmonic_damping``); ``mode`` (index into
-        :attr:`frequencies_hz_` of the selected mode a stable pole belongs to, -1 otherwise). Plot e.g.
-        ``ax.plot(row["frequencies_hz"][row["stable"]], [row["order"]] * row["stable"].sum(), "k.")``.
+        :attr:`frequencies_hz_` of the selected mode a stable pole belongs to, -1 otherwise) and ``line`` (index
+        into :attr:`harmonics_` of the harmonic line a pole belongs to, -1 otherwise). A stable pole with
+        ``mode == -1`` passed the criteria against the lower order but belongs to no mode (its cluster holds
+        stable poles at fewer than ``min_stable`` orders, or lies outside ``freq_range_hz``). Plot e.g.
+        ``ax.plot(row["frequencies_hz"][row["mode"] >= 0], [row["order"]] * (row["mode"] >= 0).sum(), "k.")``.
     singular_values_ : ndarray (min(p, r) * i,)
         Singular values of the block Toeplitz matrix (a gap suggests the model order).
     correlations_ : ndarray (2 i, p, r)
@@ -518,6 +523,9 @@ class SSICov:
         for idx, m in enumerate(modes):
             for k, j in m.pop("members"):
                 rows[k]["mode"][j] = idx
+        for idx, h in enumerate(harmonics):
+            for k, j in h.pop("members"):
+                rows[k]["line"][j] = idx
 
         self.dt_ = dt_raw
         self.lag_step_ = step
@@ -534,6 +542,7 @@ class SSICov:
         self.frequencies_hz_ = np.array([m["frequency_hz"] for m in modes])
         self.damping_ratios_ = np.array([m["damping_ratio"] for m in modes])
         self.n_stable_ = np.array([m["n_stable"] for m in modes], dtype=int)
+        self.min_stable_ = int(min_stable)
         self.modes_ = np.stack([m["shape"] for m in modes], axis=1) if modes else np.zeros((p, 0), complex)
         wd = 2 * np.pi * self.frequencies_hz_
         z = self.damping_ratios_
@@ -582,6 +591,7 @@ class SSICov:
             row["stable"] = sf & sd & sm & structural
             row["harmonic"] = sf & sm & (np.abs(z) < tol["harmonic_damping"])
             row["mode"] = np.full(k, -1, dtype=int)
+            row["line"] = np.full(k, -1, dtype=int)
             prev = row
 
     @staticmethod

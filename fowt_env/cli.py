@@ -485,24 +485,35 @@ def _demo_sensing(rec, model, case, folder: Path) -> None:
     print(f"wrote {res.plot(folder, truth=truth)} ({time.perf_counter() - t0:.1f} s)")
 
 
-def _demo_identification(rec, model, case, folder: Path) -> None:
-    """Output-only identification of the demo record, side by side with the model's own linearisation."""
+def _demo_psd(rec, modes, case, out: Path) -> Path:
+    """The demo's PSD of the tower-top accelerations, marked with ``modes`` (the model linearised at ``case``,
+    the same modes the modal table prints and the identification is checked against) and the rotor's 1P/3P/6P."""
+    from .plots import psd_figure
+
+    return psd_figure(rec, ["TwHt9ALxt", "TwHt9ALyt"], out / "psd_tower_top_acceleration.png",
+                      modes=list(zip(modes.labels, modes.frequencies_hz, strict=True)), rotor_rpm=case.rotor_rpm,
+                      title=f"Tower-top acceleration, {case.name} (modes: linear model at {case.name})")
+
+
+def _demo_identification(rec, model, case, folder: Path):
+    """Output-only identification of the demo record, side by side with the model's own linearisation; returns
+    the :class:`~fowt_env.identification.IdentificationResult` it printed and drew."""
     from .identification import identify, model_reference
 
     print("\nIdentification from the 18 fore-aft tower channels alone (Hankel-DMD, 2.5 s of delays, rank 24; "
-          "SSI-COV), against the linearised model at this load case:")
+          f"SSI-COV), against the model linearised at {case.name} (a line more than 10 % from every model mode "
+          "is not called structural):")
     ref = model_reference(model, case, plane="FA")
     t0 = time.perf_counter()
     res = identify(rec, plane="FA", reference=ref)
     print(res.summary())
     paths = res.plot(folder)
     print(f"wrote {len(paths)} figures to {folder} ({time.perf_counter() - t0:.1f} s)")
+    return res
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
     import surrogates
-
-    from .plots import psd_figure
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -511,8 +522,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     print(f"fowt-env demo: NREL 5 MW on OC3 Hywind, {case.name}: Hs={case.hs} m, Tp={case.tp} s, "
           f"waves {case.wave_dir_deg} deg, wind {case.wind_speed} m/s (TI {case.turbulence_intensity:.3f})")
     print(f"effects: {model.effects}")
-    modes = model.modal_analysis()
-    print("\nModal analysis (parked, still water):")
+    modes = model.modal_analysis(case)
+    print(f"\nModal analysis of the model linearised at {case.name} (the modes the PSD marks and the "
+          "identification is checked against):")
     print(modes)
     rec, wall = _timed_simulation(model, case, duration=args.duration, dt=0.0125, seed=args.seed)
     print(f"\nSimulated {rec.duration:.0f} s at 80 Hz in {wall:.2f} s ({rec.duration / max(wall, 1e-9):.0f}x real "
@@ -520,9 +532,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     print(_stats_table(rec, ["PtfmSurge", "PtfmPitch", "PtfmYaw", "RotSpeed", "TwHt1MLyt", "TwHt1MLxt",
                              "TwHt9ALxt", "TwHt9ALyt", "Wave1Elev", "Wind1VelX"]))
     path = rec.save(out / f"{case.name.lower()}_seed{args.seed}.npz")
-    fig = psd_figure(rec, ["TwHt9ALxt", "TwHt9ALyt"], out / "psd_tower_top_acceleration.png",
-                     modes=list(zip(modes.labels, modes.frequencies_hz, strict=True)), rotor_rpm=case.rotor_rpm,
-                     title=f"Tower-top acceleration, {case.name} (modes: parked linear model)")
+    fig = _demo_psd(rec, modes, case, out)
     print(f"\nwrote {path}\nwrote {fig}")
     _demo_identification(rec, model, case, out / "identification")
     _demo_sensing(rec, model, case, out / "sensing")

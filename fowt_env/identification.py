@@ -6,13 +6,15 @@ the chosen channels as the seed paper does (4th-order Butterworth 0.25-5 Hz, zer
 * :class:`estimators.HankelDMD` (mode table with structural / harmonic / noise labels), and
 * :class:`estimators.SSICov` (stabilisation diagram, stable poles),
 
-both on the same data, and, when the record carries the rotor speed (``RotSpeed``), finds the rotor harmonics
-(1P, 3P, 6P) by Hankel-DMD in the order domain (:func:`estimators.rotor_harmonics`): a 3P load on a rotor whose
-speed follows the turbulence is a band in time but a line at order 3 in azimuth. Mode shapes are returned in
-the record's physical units (the z-scoring is undone), so they compare directly with the output shapes ``C v``
-of a linear model: :func:`linear_reference` gives those for a ``control.StateSpace`` (e.g.
-``FOWTModel.linearize(case, plane="FA")``) and :func:`identify` pairs every method's modes with them
-(frequency and MAC) when a reference is given -- the seed paper's Table 3.
+both on the same data (with a linear reference, a line labelled ``"structural"`` by either method that lies
+more than ``max_freq_rel``, 10 %, from every mode of the model is relabelled by what it is: ``"rotor_band"``
+inside the band a rotor harmonic sweeps, else ``"unmodelled"``), and, when the record carries the rotor speed
+(``RotSpeed``), finds the rotor harmonics (1P, 3P, 6P) by Hankel-DMD in the order domain
+(:func:`estimators.rotor_harmonics`): a 3P load on a rotor whose speed follows the turbulence is a band in time
+but a line at order 3 in azimuth. Mode shapes are returned in the record's physical units (the z-scoring is
+undone), so they compare directly with the output shapes ``C v`` of a linear model: :func:`linear_reference`
+gives those for a ``control.StateSpace`` (e.g. ``FOWTModel.linearize(case, plane="FA")``) and :func:`identify`
+pairs every method's modes with them (frequency and MAC) when a reference is given -- the seed paper's Table 3.
 
 :meth:`IdentificationResult.plot` draws the figures people look at: the stabilisation diagram over the PSD,
 the DMD eigenvalues on the unit circle, the singular-value spectrum with the chosen rank, and a spectrogram
@@ -34,7 +36,17 @@ from estimators.order_tracking import rotor_azimuth, rotor_harmonics
 from estimators.preprocess import Preprocessor
 from estimators.ssi_cov import SSICov
 
-__all__ = ["IdentificationResult", "LinearReference", "identify", "linear_reference", "model_reference"]
+__all__ = [
+    "KIND_MEANING",
+    "ROTOR_ORDERS",
+    "IdentificationResult",
+    "LinearReference",
+    "identify",
+    "label_against_model",
+    "linear_reference",
+    "model_reference",
+    "rotor_bands",
+]
 
 _TOWER_PREFIX = "TwHt"
 
@@ -55,6 +67,10 @@ class LinearReference:
         Mode names if known (else ``mode_1`` ...).
     channels : list of str
         Output names.
+    model_modes : tuple of (str, float)
+        Every mode of the model at its operating point as (label, frequency in Hz), whatever its plane or band
+        (platform, both tower planes): the modes :func:`identify`'s labelling rule measures distances to. Empty:
+        the reference's own modes.
     """
 
     frequencies_hz: np.ndarray
@@ -62,6 +78,13 @@ class LinearReference:
     shapes: np.ndarray
     labels: list[str]
     channels: list[str]
+    model_modes: tuple[tuple[str, float], ...] = ()
+
+    def all_modes(self) -> list[tuple[str, float]]:
+        """(label, frequency in Hz) of every model mode: :attr:`model_modes`, else the reference's own modes."""
+        if self.model_modes:
+            return [(str(lab), float(f)) for lab, f in self.model_modes]
+        return [(lab, float(f)) for lab, f in zip(self.labels, self.frequencies_hz, strict=True)]
 
 
 def linear_reference(system: Any, *, labels: dict[str, float] | None = None, f_min: float = 0.0,
@@ -122,15 +145,17 @@ def model_reference(model: Any, case: Any = None, plane: str | None = None) -> L
     -------
     LinearReference
         Tower modes labelled as :meth:`FOWTModel.modal_analysis` names them (the platform modes lie below the
-        identification band).
+        identification band); :attr:`~LinearReference.model_modes` lists every mode of the modal analysis at
+        ``case`` (platform and both tower planes).
     """
     modes = model.modal_analysis(case)
     wanted = {lab: f for lab, f in zip(modes.labels, modes.frequencies_hz, strict=True) if lab.startswith("tower_")}
     ref = linear_reference(model.linearize(case, plane=plane), labels=wanted, f_min=0.5 * min(wanted.values()))
     keep = [k for k, lab in enumerate(ref.labels) if lab in wanted
             and (plane is None or lab.startswith(f"tower_{plane.lower()}_"))]
+    every = tuple((str(lab), float(f)) for lab, f in zip(modes.labels, modes.frequencies_hz, strict=True))
     return LinearReference(ref.frequencies_hz[keep], ref.damping_ratios[keep], ref.shapes[:, keep],
-                           [ref.labels[k] for k in keep], ref.channels)
+                           [ref.labels[k] for k in keep], ref.channels, model_modes=every)
 
 
 @dataclass
@@ -153,9 +178,11 @@ class IdentificationResult:
     ssi : estimators.SSICov or None
     dmd_modes : list of dict
         :meth:`HankelDMD.mode_table` rows (``frequency_hz``, ``damping_ratio``, ``energy``, ``phase_locking``,
-        ``kind``, ``index``).
+        ``kind``, ``index``); with a reference, checked by :func:`label_against_model` (kinds
+        ``"rotor_band"`` and ``"unmodelled"`` besides the table's own, ``model_mode`` / ``rotor_order``).
     ssi_modes : list of dict
-        :meth:`SSICov.mode_table` rows.
+        :meth:`SSICov.mode_table` rows, checked the same way: the modes made of the stabilisation diagram's
+        filled poles (stable at ``ssi.min_stable_`` orders or more) and the harmonic lines.
     reference : LinearReference or None
     pairs : dict of str to list of dict
         For each method (``"dmd"``, ``"ssi"``), the reference modes paired with its modes: ``label``,
@@ -166,6 +193,8 @@ class IdentificationResult:
         ``damping_ratio``, ``phase_locking``, ``energy``, ``kind``); None when no order tracking was done.
     rotor_speed_source : str
         Where the rotor speed came from (a channel name, ``"array"``), or why there are no harmonics.
+    max_freq_rel : float
+        Tolerance of the pairing and of the check of structural lines against the model.
     """
 
     channels: list[str]
@@ -181,6 +210,7 @@ class IdentificationResult:
     pairs: dict[str, list[dict]] = field(default_factory=dict)
     harmonics: list[dict] | None = None
     rotor_speed_source: str = "not requested"
+    max_freq_rel: float = 0.1
     _spectrogram_channel: str | None = None
     _y: np.ndarray | None = None
     _rotor_hz: np.ndarray | None = None
@@ -218,16 +248,31 @@ class IdentificationResult:
             out["pairs"] = self.pairs
         return out
 
-    def summary(self, kinds: tuple[str, ...] = ("structural", "harmonic")) -> str:
-        """A readable table: DMD modes of the given kinds, SSI stable modes, and the reference pairing."""
+    def summary(self, kinds: tuple[str, ...] = ("structural", "harmonic", "rotor_band", "unmodelled")) -> str:
+        """A readable table: DMD modes of the given kinds, SSI-COV modes, and the reference pairing.
+
+        Parameters
+        ----------
+        kinds : tuple of str
+            DMD kinds to list (default all but ``"noise"``).
+
+        Returns
+        -------
+        str
+            The DMD lines with their kind (and, with a reference, the model mode each structural line is
+            nearest to, or the rotor order of a rotor band), the SSI-COV modes -- exactly the clusters of the
+            stabilisation diagram's filled poles, with the orders at which each is stable -- and the pairing.
+        """
         d, h = self.dmd.delays_, self.dmd.dt_
         lines = [f"Hankel-DMD: delays {d} samples ({d * h:.2f} s at {1 / h:.0f} Hz), rank {self.dmd.rank_} "
                  f"({self.dmd.method_}), {len(self.channels)} channels"]
         lines.append(f"  {'f (Hz)':>8} {'zeta (%)':>9} {'energy':>7} {'locking':>8}  kind")
+        shown: set[str] = set()
         for row in self.dmd_modes:
             if row["kind"] in kinds:
+                shown.add(row["kind"])
                 lines.append(f"  {row['frequency_hz']:8.4f} {100 * row['damping_ratio']:9.2f} {row['energy']:7.3f} "
-                             f"{row['phase_locking']:8.2f}  {row['kind']}")
+                             f"{row['phase_locking']:8.2f}  {_kind_text(row)}")
         if self.harmonics is None:
             lines.append(f"Rotor harmonics: not tracked ({self.rotor_speed_source})")
         else:
@@ -239,13 +284,26 @@ class IdentificationResult:
                 lines.append(f"  {row['order']:6.2f} {row['frequency_hz']:8.4f} {lo:6.3f}-{hi:<6.3f} "
                              f"{row['phase_locking']:8.2f}")
         if self.ssi is not None:
-            lines.append(f"SSI-COV: {len(self.ssi_modes)} stable modes")
+            n_orders = int(self.ssi.orders_.size)
+            loose = sum(int(np.count_nonzero(np.asarray(r["stable"]) & (np.asarray(r["mode"]) < 0)))
+                        for r in self.ssi.stabilization_)
+            lines.append(f"SSI-COV: {len(self.ssi_modes)} modes and lines (each from poles stable at >= "
+                         f"{self.ssi.min_stable_} of {n_orders} orders: the filled poles of the stabilisation "
+                         "diagram)")
             if not self.ssi_modes:
                 lines.append("  (no pole stable over the model orders: a longer record usually helps)")
             else:
-                lines.append(f"  {'f (Hz)':>8} {'zeta (%)':>9}")
+                lines.append(f"  {'f (Hz)':>8} {'zeta (%)':>9} {'orders':>7}  kind")
             for row in self.ssi_modes:
-                lines.append(f"  {row['frequency_hz']:8.4f} {100 * row['damping_ratio']:9.2f}")
+                shown.add(row["kind"])
+                lines.append(f"  {row['frequency_hz']:8.4f} {100 * row['damping_ratio']:9.2f} {row['n_stable']:7d}"
+                             f"  {_kind_text(row)}")
+            if loose:
+                lines.append(f"  ({loose} further poles passed the stability test against the next lower order "
+                             "but form no mode: hollow in the diagram)")
+        relabelled = sorted(shown & {"rotor_band", "unmodelled"})
+        for kind in relabelled:
+            lines.append(f"{kind}: " + KIND_MEANING[kind].format(tol=f"{100 * self.max_freq_rel:g}"))
         if self.reference is not None:
             lines.append("Against the linear reference (f in Hz, zeta in %, MAC of output shapes):")
             head = f"  {'mode':<12}{'f_lin':>8}{'z_lin':>7}"
@@ -289,6 +347,15 @@ class IdentificationResult:
         return paths
 
 
+def _kind_text(row: dict) -> str:
+    """A mode-table row's kind as the summary prints it: ``structural (tower_fa_1)``, ``rotor_band (3P)``."""
+    if row.get("model_mode"):
+        return f"{row['kind']} ({row['model_mode']})"
+    if row.get("rotor_order"):
+        return f"{row['kind']} ({row['rotor_order']}P)"
+    return str(row["kind"])
+
+
 def _default_channels(record: Any, plane: str | None) -> list[str]:
     if plane is not None:
         return record.planar(plane).channels
@@ -312,6 +379,91 @@ def _pair(reference: LinearReference, freqs: np.ndarray, zetas: np.ndarray, shap
 
 
 _SPEED_UNITS = {"rpm": np.pi / 30.0, "rad/s": 1.0}
+
+#: Rotor orders whose swept band names a line that no model mode explains: 1P and blade passing (3P, 6P), the
+#: lines the demo's PSD marks.
+ROTOR_ORDERS: tuple[int, ...] = (1, 3, 6)
+
+#: What each kind of an identified line means (the summary's legend; ``{tol}``: the tolerance in per cent).
+KIND_MEANING: dict[str, str] = {
+    "structural": "a damped mode of the response (with a reference: within {tol} % of the model mode named)",
+    "harmonic": "an undamped, phase-locked forced line",
+    "rotor_band": "no model mode within {tol} %; inside the band that rotor harmonic (1P, 3P, 6P) sweeps as the "
+                  "rotor speed varies",
+    "unmodelled": "no model mode within {tol} % and no rotor band: wave band, band-pass edge or a response the "
+                  "linear model lacks",
+}
+
+
+def rotor_bands(rotor_hz: np.ndarray, orders: tuple[int, ...] = ROTOR_ORDERS,
+                percentiles: tuple[float, float] = (1.0, 99.0)) -> dict[int, tuple[float, float]]:
+    """The frequency bands that rotor harmonics sweep as the rotor speed varies.
+
+    Parameters
+    ----------
+    rotor_hz : ndarray (n_samples,)
+        Rotor speed in revolutions per second (Hz).
+    orders : tuple of int
+        Harmonic orders (1 = 1P, 3 = blade passing 3P, ...).
+    percentiles : (float, float)
+        Percentiles of the speed that bound each band (default 1 and 99: a few outlying samples do not widen it).
+
+    Returns
+    -------
+    dict of int to (float, float)
+        ``{order: (f_low, f_high)}`` in Hz.
+    """
+    lo, hi = np.percentile(np.asarray(rotor_hz, dtype=float), percentiles)
+    return {int(k): (float(k * lo), float(k * hi)) for k in orders}
+
+
+def label_against_model(rows: list[dict], model_modes: list[tuple[str, float]], max_freq_rel: float = 0.1,
+                        bands: dict[int, tuple[float, float]] | None = None) -> list[dict]:
+    """Check the ``"structural"`` rows of a mode table against a model's modes and relabel the ones it lacks.
+
+    A data-driven method calls a line ``"structural"`` when it is damped and carries energy; that is also true of a
+    forcing band (the rotor's 3P swept by a turbulent rotor speed, the wave spectrum let through by the band-pass
+    edge). With a model at hand the label means what a reader takes it to mean, a mode of the structure, only if
+    the model has a mode near it: the same tolerance that pairs identified modes with the reference
+    (``max_freq_rel``, 10 % by default) decides.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Mode-table rows with ``frequency_hz`` and ``kind`` (:meth:`HankelDMD.mode_table`,
+        :meth:`SSICov.mode_table`); changed in place.
+    model_modes : list of (str, float)
+        Every mode of the model as (label, frequency in Hz) (:meth:`LinearReference.all_modes`).
+    max_freq_rel : float
+        Largest relative distance ``|f - f_model| / f_model`` of a line still called structural.
+    bands : dict of int to (float, float), optional
+        Rotor-harmonic bands (:func:`rotor_bands`); None: no rotor speed known.
+
+    Returns
+    -------
+    list of dict
+        ``rows``: each ``"structural"`` row within ``max_freq_rel`` of a model mode gains ``model_mode`` (the
+        nearest mode's label; :func:`identify` then names the reference mode a line is paired with, by frequency
+        and shape, instead); the others become ``"rotor_band"`` (with ``rotor_order``, the lowest order whose
+        band, widened by ``max_freq_rel``, holds the line) or ``"unmodelled"``.
+    """
+    known = [(lab, f) for lab, f in model_modes if f > 0]
+    for row in rows:
+        if row["kind"] != "structural":
+            continue
+        f = float(row["frequency_hz"])
+        near = min(known, key=lambda m: abs(f - m[1]) / m[1], default=None)
+        if near is not None and abs(f - near[1]) <= max_freq_rel * near[1]:
+            row["model_mode"] = near[0]
+            continue
+        order = next((k for k, (lo, hi) in sorted((bands or {}).items())
+                      if (1 - max_freq_rel) * lo <= f <= (1 + max_freq_rel) * hi), None)
+        if order is None:
+            row["kind"] = "unmodelled"
+        else:
+            row["kind"] = "rotor_band"
+            row["rotor_order"] = int(order)
+    return rows
 
 
 def _rotor_speed(record: Any, rotor_speed: Any) -> tuple[np.ndarray | None, np.ndarray | None, str]:
@@ -393,9 +545,14 @@ def identify(
     ssi_orders : iterable of int, optional
         SSI-COV model orders (default 2, 4, ..., 80).
     reference : LinearReference, optional
-        Linear modes to pair with (:func:`linear_reference`); its output names must cover ``channels``.
+        Linear modes to pair with (:func:`linear_reference`); its output names must cover ``channels``. With a
+        reference, both mode tables are checked against the model (:func:`label_against_model`): a
+        ``"structural"`` line more than ``max_freq_rel`` from every model mode
+        (:meth:`LinearReference.all_modes`) becomes ``"rotor_band"`` or ``"unmodelled"``, the others name
+        their ``model_mode``; only lines still ``"structural"`` are paired.
     max_freq_rel : float
-        Largest relative frequency difference accepted when pairing with the reference.
+        Largest relative frequency difference accepted when pairing with the reference, and between a line
+        called structural and its nearest model mode (default 10 %).
     rotor_speed : "auto", str, ndarray or None
         Rotor speed for the order-tracked harmonics: a channel name (units rpm or rad/s), an array
         ``(n_samples,)`` in rad/s, ``None`` (skip), or ``"auto"`` (default): the ``RotSpeed`` channel if the
@@ -456,18 +613,29 @@ def identify(
         harmonics = rotor_harmonics(Zd, dt_d, azimuth=azimuth[::q], delays=depths, rank=rank)
     res = IdentificationResult(names, [sub.units[i] for i in range(len(names))], dt, (lo, hi), filtered_std, dmd,
                                ssi_est, dmd_modes, ssi_modes, harmonics=harmonics, rotor_speed_source=speed_source,
+                               max_freq_rel=float(max_freq_rel),
                                _rotor_hz=None if speed is None else speed / (2.0 * np.pi), _y=Y,
                                _spectrogram_channel=next((c for c in reversed(names) if c.endswith("ALxt") or
                                                           c.endswith("ALyt")), names[0]))
     if reference is not None:
         rows = [reference.channels.index(c) for c in names]
         ref = LinearReference(reference.frequencies_hz, reference.damping_ratios, reference.shapes[rows],
-                              reference.labels, names)
+                              reference.labels, names, model_modes=reference.model_modes)
         res.reference = ref
+        bands = None if speed is None else rotor_bands(speed / (2.0 * np.pi))
+        label_against_model(dmd_modes, ref.all_modes(), max_freq_rel, bands)
+        label_against_model(ssi_modes, ref.all_modes(), max_freq_rel, bands)
         structural = [r["index"] for r in dmd_modes if r["kind"] == "structural"]
         res.pairs["dmd"] = _pair(ref, np.abs(dmd.frequencies_hz_[structural]), dmd.damping_ratios_[structural],
                                  dmd.modes_[:, structural] * filtered_std[:, None], max_freq_rel)
         if ssi_est is not None:
-            res.pairs["ssi"] = _pair(ref, np.asarray(ssi_est.frequencies_hz_), np.asarray(ssi_est.damping_ratios_),
-                                     np.asarray(ssi_est.modes_) * filtered_std[:, None], max_freq_rel)
+            kept = [r["index"] for r in ssi_modes if r["kind"] == "structural"]
+            res.pairs["ssi"] = _pair(ref, np.asarray(ssi_est.frequencies_hz_)[kept],
+                                     np.asarray(ssi_est.damping_ratios_)[kept],
+                                     np.asarray(ssi_est.modes_)[:, kept] * filtered_std[:, None], max_freq_rel)
+        for method, table in (("dmd", dmd_modes), ("ssi", ssi_modes)):  # a paired line names its reference mode
+            for pair in res.pairs.get(method, []):
+                for row in table:
+                    if row["kind"] == "structural" and np.isclose(row["frequency_hz"], pair["f"], rtol=1e-12):
+                        row["model_mode"] = pair["label"]
     return res

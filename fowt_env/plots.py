@@ -16,7 +16,8 @@ __all__ = [
 ]
 
 
-_KIND_STYLE = {"structural": ("tab:blue", "o"), "harmonic": ("tab:red", "D"), "noise": ("0.6", ".")}
+_KIND_STYLE = {"structural": ("tab:blue", "o"), "harmonic": ("tab:red", "D"), "rotor_band": ("tab:orange", "s"),
+               "unmodelled": ("tab:purple", "v"), "noise": ("0.6", ".")}
 
 
 def _pyplot():
@@ -241,6 +242,11 @@ def stabilization_figure(ssi, Y: np.ndarray, dt: float, path: str | Path, refere
                          f_max: float | None = None) -> Path:
     """SSI-COV stabilisation diagram over the averaged PSD of the channels, with the selected modes marked.
 
+    Filled black circles are exactly the poles of the modes :meth:`~estimators.SSICov.mode_table` reports
+    (stable at ``ssi.min_stable_`` orders or more), red diamonds the poles of its harmonic lines; a pole that
+    passed the stability test against the next lower order without forming a mode is hollow, any other pole a
+    grey cross.
+
     Parameters
     ----------
     ssi : estimators.SSICov
@@ -267,18 +273,32 @@ def stabilization_figure(ssi, Y: np.ndarray, dt: float, path: str | Path, refere
         top = max((float(np.max(r["frequencies_hz"])) for r in rows if len(r["frequencies_hz"])), default=1.0)
         f_max = min(1.05 * top, 0.5 / dt)
     fig, ax = plt.subplots(figsize=(10, 5.5))
-    first = {True: True, False: True}
+    n_min = getattr(ssi, "min_stable_", None)
+    at = f" (>= {n_min} orders)" if n_min else ""
+    kinds = {  # category: (label, style), drawn in this order
+        "pole": ("pole", dict(marker="x", color="0.7", s=10)),
+        "loose": ("stable vs. lower order, no mode", dict(marker="o", facecolors="none", edgecolors="0.45", s=12,
+                                                          linewidths=0.7)),
+        "line": ("stable pole of a harmonic line", dict(marker="D", color="tab:red", s=10)),
+        "mode": (f"stable pole of a reported mode{at}", dict(marker="o", color="k", s=9)),
+    }
+    points: dict[str, list[tuple[float, int]]] = {k: [] for k in kinds}
     for r in rows:
         f = np.asarray(r["frequencies_hz"])
-        st = np.asarray(r["stable"], dtype=bool)
-        for flag, style in ((False, dict(marker="x", color="0.7", s=10)), (True, dict(marker="o", color="k", s=9))):
-            sel = (st == flag) & (f <= f_max)
-            if sel.any():
-                lab = ("stable pole" if flag else "unstable pole") if first[flag] else None
-                first[flag] = False
-                ax.scatter(f[sel], np.full(sel.sum(), r["order"]), label=lab, **style)
+        n = f.size
+        mode = np.asarray(r.get("mode", np.full(n, -1))) >= 0
+        line = np.asarray(r.get("line", np.full(n, -1))) >= 0
+        loose = np.asarray(r.get("stable", np.zeros(n, bool)), dtype=bool) & ~mode & ~line
+        for key, sel in (("mode", mode), ("line", line & ~mode), ("loose", loose), ("pole", ~(mode | line | loose))):
+            points[key] += [(float(fk), int(r["order"])) for fk in f[sel & (f <= f_max)]]
+    for key, (label, style) in kinds.items():
+        if points[key]:
+            xy = np.array(points[key])
+            ax.scatter(xy[:, 0], xy[:, 1], label=label, **style)
     for k, fk in enumerate(ssi.frequencies_hz_):
-        ax.axvline(fk, color="tab:blue", lw=1.0, alpha=0.6, label="selected mode" if k == 0 else None)
+        ax.axvline(fk, color="tab:blue", lw=1.0, alpha=0.6, label="reported mode" if k == 0 else None)
+    for k, h in enumerate(getattr(ssi, "harmonics_", [])):
+        ax.axvline(h["frequency_hz"], color="tab:red", ls=":", lw=1.0, label="harmonic line" if k == 0 else None)
     if reference is not None:
         for lab, fk in zip(reference.labels, reference.frequencies_hz, strict=True):
             if fk <= f_max:
