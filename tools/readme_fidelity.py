@@ -7,7 +7,11 @@ markers of README.md (nothing else in the file changes) and saves the 12 m/s PSD
 
 Usage::
 
-    python tools/readme_fidelity.py [--seeds 8] [--readme README.md] [--table-only FILE]
+    python tools/readme_fidelity.py [--seeds 8] [--readme README.md] [--figure docs/figures/fidelity_psd_c_op12.png]
+
+``--seeds`` is the surrogate seeds per operating run, ``--readme`` the file whose marked block is rewritten and
+``--figure`` where the 12 m/s PSD overlay is saved. Every run validates, rewrites
+the block and overwrites the figure.
 """
 
 from __future__ import annotations
@@ -36,9 +40,10 @@ def block(report, seeds: int) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--seeds", type=int, default=8)
-    ap.add_argument("--readme", type=Path, default=REPO / "README.md")
-    ap.add_argument("--figure", type=Path, default=REPO / "docs" / "figures" / "fidelity_psd_c_op12.png")
+    ap.add_argument("--seeds", type=int, default=8, help="surrogate seeds per operating run (default 8)")
+    ap.add_argument("--readme", type=Path, default=REPO / "README.md", help="file with the marked block")
+    ap.add_argument("--figure", type=Path, default=REPO / "docs" / "figures" / "fidelity_psd_c_op12.png",
+                    help="where the 12 m/s PSD overlay is written")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         rep = validate(seeds=args.seeds, plot_dir=tmp)
