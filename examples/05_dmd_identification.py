@@ -26,13 +26,17 @@ What to look for.
 * The 2nd tower modes (2.15 Hz side-to-side, 2.55 Hz fore-aft) are found too, MAC ~ 1. Take that with care:
   the surrogate's rotationally sampled turbulence drives its 2-3 Hz band several times harder than OpenFAST
   does (main README, Known limits), so they would be harder to find on OpenFAST data.
-* DMD lists further "structural" lines that the model does not have, e.g. 0.52-0.65 Hz (the 3P forcing band)
-  and 2.0, 2.3-2.4 and 2.9 Hz (the 2-3 Hz band the rotationally sampled turbulence drives). Pairing with a
-  reference is what tells them apart; without one, look at the stabilisation diagram and the energy column.
+* Both tables list more lines than the model has modes. Each line's ``kind`` names the nearest model mode
+  within 10 % (``structural (tower_fa_1)``); lines with none are ``rotor_band (3P)`` when they sit in the band
+  a rotor harmonic sweeps (0.58-0.65 Hz here) or ``unmodelled`` otherwise (e.g. DMD's 2.89 Hz, SSI-COV's
+  side-to-side 0.31 Hz). The 10 % rule goes by frequency only: the 2.0 and 2.3-2.4 Hz lines of the 2-3 Hz band
+  that the rotationally sampled turbulence drives are still labelled after a 2nd tower mode. The pairing table
+  (frequency *and* MAC) is what tells the modes apart; without a reference, look at the stabilisation diagram
+  and the energy column.
 * The 3P forcing (blade passing, three times the rotor speed) is a *band* in time: the rotor speed follows the
   turbulence, so the line wanders (the spectrogram shows it, with its 3P track drawn over it), and SSI-COV
-  reports it as a heavily damped "mode" near 0.59 Hz (7-9 % damping) in both planes, like the seed paper's
-  side-to-side 0.638 Hz / 10.6 %. Order tracking (resampling at equal rotor-azimuth steps, using the
+  finds a heavily damped line near 0.59 Hz (7-9 % damping, ``rotor_band (3P)``) in both planes, where the seed
+  paper reported a side-to-side "mode" at 0.638 Hz / 10.6 %. Order tracking (resampling at equal rotor-azimuth steps, using the
   ``RotSpeed`` channel) turns every rotor-locked load into a line again, but in this turbulent case the "Rotor
   harmonics" table is empty: most of the 3P content is the blades' rotational sampling of the turbulence, which
   has no fixed phase to the azimuth (order tracking finds no line in OpenFAST's turbulent 12 m/s run either).
