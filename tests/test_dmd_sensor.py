@@ -127,7 +127,11 @@ def test_paper_scenarios_on_short_surrogate_data(spar):
         # broadband load no other channel sees in advance (R2 0.79-0.83; 0.94 with rotor_asymmetry off), and the
         # accelerations no longer carry gravity's share of the slow, predictable platform pitch (0.90-0.95).
         # A sensor that has lost the dynamics scores near 0 on these channels (they are hidden throughout).
-        assert np.median(r2) >= 0.85 and r2.min() >= 0.75
+        # Since the rotor's aerodynamic tilt/yaw damping (the disc's own rates, issue 15) the 1st tower mode is
+        # damped 3.5-4.4 % instead of 2.2-2.7 % and the 2nd tower mode's content is halved, as OpenFAST's tower
+        # band asks: the tower responds less modally and the nacelle moment carries the damping moment too.
+        # Measured: A median 0.89 / min 0.64, B 0.93 / 0.55, C 0.82 / 0.53 (the nacelle moment).
+        assert np.median(r2) >= 0.8 and r2.min() >= 0.45
 
 
 def test_accuracy_falls_with_the_update_interval(spar):
@@ -162,7 +166,7 @@ def test_nan_in_live_channels_is_a_dropout(spar):
     hidden = [0, 8, 9, 17]
     clean = r2_score(truth, sensor.reconstruct(y, mask))[hidden]
     assert np.all(r2_score(truth, est_nan)[hidden] > clean - 0.01)
-    assert clean.min() > 0.7 and np.median(clean) > 0.9
+    assert clean.min() > 0.55 and np.median(clean) > 0.9  # clean min 0.62 since the rotor's tilt damping
 
 
 def test_total_blackout_runs_open_loop_and_recovers(spar):
@@ -194,8 +198,10 @@ def test_mask_changing_every_sample(spar):
     print(f"\nmask changing every sample (40 % lost): R2 of lost samples {np.round(r2, 3)}")
     # min was > 0.8: the nacelle moment TwHt9MLyt (channel 17) now carries the rotor's turbulent tilt moment,
     # which the other channels do not see (~0.76, see the scenario test); every other channel > 0.9
-    assert np.median(r2) > 0.95 and r2.min() > 0.7
-    assert np.delete(r2, 17).min() > 0.9
+    # (0.61 since the rotor's aerodynamic tilt damping moved the tower's content, see the scenario test; the
+    # mid-tower accelerations 0.82-0.88, every other channel > 0.93)
+    assert np.median(r2) > 0.95 and r2.min() > 0.55
+    assert np.delete(r2, 17).min() > 0.75
 
 
 def test_spikes_and_a_stuck_sensor_are_gated(spar):
