@@ -118,12 +118,11 @@ class ProgressExecutor(Executor):
 
 
 def _bar(total: int | None, desc: str, enabled: bool | None, initial: int = 0):
-    from tqdm.auto import tqdm
+    """The shared progress bar (:func:`fowt_env.progress.progress_bar`: total and ETA, on a terminal by default),
+    left on screen when done."""
+    from .progress import progress_bar
 
-    if enabled is None:
-        enabled = bool(getattr(sys.stderr, "isatty", lambda: False)())
-    return tqdm(total=total, initial=initial, desc=desc, unit="task", file=sys.stderr, disable=not enabled,
-                dynamic_ncols=True, smoothing=0.1)
+    return progress_bar(total, desc, unit="tasks", progress=enabled, initial=initial, leave=True, stream=sys.stderr)
 
 
 def _count(spec: str, text: str) -> int:

@@ -284,13 +284,20 @@ def _cmd_episode(args: argparse.Namespace) -> int:
 
     keep(obs, info)
     zero = np.zeros(2, dtype=np.float32)
+    from .progress import progress_bar
+
     t0 = time.perf_counter()
-    for _ in range(n - 1):
-        obs, _, term, _, info = env.step(zero)
-        keep(obs, info)
-        if term:
-            print("episode terminated (physical failure)")
-            break
+    terminated = False
+    with progress_bar(n - 1, "episode", unit="steps", progress=None) as bar:
+        for _ in range(n - 1):
+            obs, _, term, _, info = env.step(zero)
+            keep(obs, info)
+            bar.update(1)
+            if term:
+                terminated = True
+                break
+    if terminated:
+        print("episode terminated (physical failure)")
     wall = time.perf_counter() - t0
     meta = {"source": "fowt-env episode", "case": env.case.to_dict(), "seed": args.seed,
             "faults": [repr(f) for f in env.faults], "plane": args.plane, "dt": env.dt}
@@ -318,7 +325,8 @@ def _cmd_discrepancy(args: argparse.Namespace) -> int:
     if case is None:
         raise _UsageError(f"{args.measured} does not state its load case: give --case (an OLC number)")
     t0 = time.perf_counter()
-    rep = discrepancy.run(measured, model, case, seed=args.seed, candidates=cands, n_seeds=args.seeds)
+    rep = discrepancy.run(measured, model, case, seed=args.seed, candidates=cands, n_seeds=args.seeds,
+                          progress=None)
     print(rep.summary())
     print(f"({time.perf_counter() - t0:.1f} s)")
     if args.json:
@@ -332,7 +340,7 @@ def _cmd_discrepancy(args: argparse.Namespace) -> int:
 def _cmd_validate(args: argparse.Namespace) -> int:
     from .validation import validate
 
-    progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
+    progress = None  # a bar on a terminal, once a step has run 2 s
     rep = validate(args.reference, seeds=args.seeds, duration=args.duration, runs=args.runs, plot_dir=args.plot,
                    progress=progress)
     print(rep.summary(graded_only=not args.all_channels), end="")
@@ -400,7 +408,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     rotor_speed = None if args.rotor_speed.lower() == "none" else args.rotor_speed
     res = identify(rec, channels=channels, plane=args.plane, delays=delays, rank=rank, ssi=not args.no_ssi,
-                   reference=ref, rotor_speed=rotor_speed)
+                   reference=ref, rotor_speed=rotor_speed, progress=None)
     print(res.summary())
     print(f"({time.perf_counter() - t0:.1f} s)")
     if args.json:
@@ -450,7 +458,8 @@ def _cmd_sense(args: argparse.Namespace) -> int:
     res = sense(rec, args.estimator, plane=None if args.plane == "all" else args.plane,
                 channels=args.channels.split(",") if args.channels else None,
                 hide=[h.strip() for h in args.hide.split(",")] if args.hide else (), train=train,
-                update_interval=args.update_interval, options=options or None, truth=truth, settings=settings)
+                update_interval=args.update_interval, options=options or None, truth=truth, settings=settings,
+                progress=None)
     print(res.summary())
     out = Path(args.out)
     out = out if out.suffix else out.with_suffix(".npz")
@@ -476,11 +485,22 @@ def _demo_sensing(rec, model, case, folder: Path) -> None:
     others = [c for c in (1, 6, 11) if c != own][:2]
     print(f"\nVirtual sensing: {', '.join(hidden)} lost (the paper's scenario B); causal Hankel-DMD sensor "
           f"(60 delays, rank 90, 1 s updates) trained on OLC {others[0]} and {others[1]} (120 s each):")
+    from .progress import progress_bar
+
     t0 = time.perf_counter()
-    train = [surrogates.simulate(model, c, duration=120.0, dt=rec.dt, seed=900 + c) for c in others]
-    truth = surrogates.simulate(model, case, duration=rec.n_samples * rec.dt, dt=rec.dt, seed=rec.meta.get("seed", 0),
-                                noise=False)
-    res = sense(rec, "dmd", hide=hidden, train=train, truth=truth)
+    with progress_bar(len(others) + 2, "sensing", progress=None) as bar:
+        bar.set_postfix_str("training records")
+        train = []
+        for c in others:
+            train.append(surrogates.simulate(model, c, duration=120.0, dt=rec.dt, seed=900 + c))
+            bar.update(1)
+        bar.set_postfix_str("noise-free truth")
+        truth = surrogates.simulate(model, case, duration=rec.n_samples * rec.dt, dt=rec.dt,
+                                    seed=rec.meta.get("seed", 0), noise=False)
+        bar.update(1)
+        bar.set_postfix_str("fit and reconstruct")
+        res = sense(rec, "dmd", hide=hidden, train=train, truth=truth)
+        bar.update(1)
     print(res.summary())
     print(f"wrote {res.plot(folder, truth=truth)} ({time.perf_counter() - t0:.1f} s)")
 
@@ -505,7 +525,7 @@ def _demo_identification(rec, model, case, folder: Path):
           "is not called structural):")
     ref = model_reference(model, case, plane="FA")
     t0 = time.perf_counter()
-    res = identify(rec, plane="FA", reference=ref)
+    res = identify(rec, plane="FA", reference=ref, progress=None)
     print(res.summary())
     paths = res.plot(folder)
     print(f"wrote {len(paths)} figures to {folder} ({time.perf_counter() - t0:.1f} s)")
@@ -544,17 +564,20 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
     print("\nDiscrepancy round trip: the record above has catenary mooring; the candidate model has linear mooring.")
     t0 = time.perf_counter()
-    rep = discrepancy.run(rec, model.without("mooring_nonlinear"), case, n_seeds=3)
+    rep = discrepancy.run(rec, model.without("mooring_nonlinear"), case, n_seeds=3, progress=None)
     print(rep.summary())
     print(f"wrote {rep.plot(out / 'discrepancy.png')} ({time.perf_counter() - t0:.0f} s)")
     return 0
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from .compare import compare
+    from .compare import compare, grid_units
 
     scenarios, estimators, kwargs = _compare_request(args)
-    with _scheduler(args.scheduler, "compare") as executor:
+    total = len(grid_units(scenarios, estimators, **{k: kwargs[k] for k in ("cases", "seeds", "update_intervals",
+                                                                            "settings")}))
+    total += kwargs["lyapunov_time"] == "auto"  # the Lyapunov estimate runs as one more task
+    with _scheduler(args.scheduler, "compare", total) as executor:
         res = compare(scenarios, estimators, executor=executor, **kwargs)
     print(res.summary())
     if args.json:
@@ -568,16 +591,17 @@ def _cmd_compare(args: argparse.Namespace) -> int:
 
 
 @contextlib.contextmanager
-def _scheduler(spec: str | None, desc: str):
-    """The executor of ``--scheduler`` (None: none, compare's in-process default), with a progress bar on stderr
-    when it is a terminal."""
+def _scheduler(spec: str | None, desc: str, total: int | None = None):
+    """The executor of ``--scheduler`` (None: none, compare's in-process default), with a progress bar of
+    ``total`` tasks on stderr when it is a terminal."""
     from .campaign import ProgressExecutor, SerialExecutor, parse_scheduler
+    from .progress import on_terminal
 
     if spec is None:
-        if not sys.stderr.isatty():
+        if not on_terminal():
             yield None
             return
-        wrapped = ProgressExecutor(SerialExecutor(), desc=desc)  # same results, a progress bar for people
+        wrapped = ProgressExecutor(SerialExecutor(), total=total, desc=desc)  # same results, a bar for people
         try:
             yield wrapped
         finally:
@@ -585,7 +609,7 @@ def _scheduler(spec: str | None, desc: str):
         return
 
     with parse_scheduler(spec) as executor:
-        wrapped = ProgressExecutor(executor, desc=desc)
+        wrapped = ProgressExecutor(executor, total=total, desc=desc)
         try:
             yield wrapped
         finally:

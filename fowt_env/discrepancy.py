@@ -29,6 +29,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy.signal import welch
@@ -36,6 +37,8 @@ from scipy.stats import kurtosis, skew
 
 import surrogates
 from surrogates import EFFECTS, FOWTModel, LoadCase, Record
+
+from .progress import progress_bar
 
 __all__ = ["run", "DiscrepancyReport", "FeatureSet", "features", "DEFAULT_CHANNELS"]
 
@@ -254,6 +257,7 @@ class _Evaluator:
         self.case, self.duration, self.dt, self.seeds, self.channels = case, duration, dt, seeds, channels
         self.cache: dict[tuple, np.ndarray] = {}
         self.n_sims = 0
+        self.bar: Any = None  # a progress bar advanced by len(seeds) per evaluation (a cached one is done at once)
 
     def feature_matrix(self, model: FOWTModel) -> np.ndarray:
         key = tuple(sorted(model.effects.items()))
@@ -261,6 +265,8 @@ class _Evaluator:
             recs = surrogates.simulate(model, self.case, duration=self.duration, dt=self.dt, seed=self.seeds)
             self.n_sims += len(self.seeds)
             self.cache[key] = np.array([features(r, self.case, self.channels).values for r in recs])
+        if self.bar is not None:
+            self.bar.update(len(self.seeds))
         return self.cache[key]
 
 
@@ -283,6 +289,7 @@ def run(
     channels: Sequence[str] = DEFAULT_CHANNELS,
     sim_dt: float | None = None,
     n_scatter: int = 8,
+    progress: bool | None = False,
 ) -> DiscrepancyReport:
     """Find, name and add the physical effect(s) a model misses, given a measured record.
 
@@ -311,6 +318,10 @@ def run(
         the model's white sensor noise is scaled so its spectral density matches the measurement's).
     n_scatter : int
         Realisations of the candidate model used to estimate the seed-to-seed scatter (>= n_seeds).
+    progress : bool or None
+        Progress in model simulations with an ETA on standard error (:func:`fowt_env.progress.progress_bar`):
+        True, False (default) or None (when it is a terminal). The total covers the search rounds known so far
+        and grows when another round starts.
 
     Returns
     -------
@@ -342,11 +353,29 @@ def run(
         model_sim = model
     seeds = [(1000 if seed is None else int(seed)) + i for i in range(int(n_seeds))]
     ev = _Evaluator(case, measured.duration + dt, dt, seeds, channels)
-
-    base_fm = ev.feature_matrix(model_sim)
     # the scatter needs more realisations than the mean: extra seeds for the candidate model only
     extra_seeds = list(range(seeds[-1] + 1, seeds[-1] + 1 + max(0, int(n_scatter) - len(seeds))))
     extra = _Evaluator(case, ev.duration, dt, extra_seeds, channels)
+
+    def round_cost(model_now: FOWTModel, skip: set[str]) -> int:  # simulations of one search round
+        return len(seeds) * sum(len(set(map(float, strengths)) - {model_now.effects[e]}) for e in cands
+                                if e not in skip)
+
+    bar = progress_bar(len(seeds) + len(extra_seeds) + round_cost(model_sim, set()) + 2, "discrepancy",
+                       unit="simulations", progress=progress)
+    ev.bar = extra.bar = bar
+    try:
+        return _search(measured, model, case, cands, strengths, max_effects, channels, meas, dt, model_sim, seeds,
+                       ev, extra, bar, round_cost)
+    finally:
+        bar.close()
+
+
+def _search(measured: Record, model: FOWTModel, case: LoadCase, cands: list[str], strengths: Sequence[float],
+            max_effects: int, channels: Sequence[str], meas: Any, dt: float, model_sim: FOWTModel, seeds: list[int],
+            ev: _Evaluator, extra: _Evaluator, bar: Any, round_cost: Any) -> DiscrepancyReport:
+    """:func:`run`'s greedy search, advancing ``bar`` by the simulations it runs."""
+    base_fm = ev.feature_matrix(model_sim)
     scatter_fm = np.vstack([base_fm, extra.feature_matrix(model_sim)]) if extra.seeds else base_fm
     scatter = _scatter(scatter_fm, meas.kinds, base_fm.mean(axis=0))
     n_f = len(meas.names)
@@ -379,6 +408,9 @@ def run(
     for _round in range(int(max_effects)):
         if g_cur <= threshold:
             break
+        if _round:  # another round: its simulations join the total
+            bar.total += round_cost(current, {n for n, _ in named})
+            bar.refresh()
         best = None
         for eff in cands:
             if eff in (n for n, _ in named):
@@ -389,6 +421,7 @@ def run(
             s_best = min(gaps, key=gaps.get)
             s_ref = _parabolic(grid, gaps, s_best)
             if s_ref is not None:
+                bar.total += len(seeds)
                 gaps[s_ref] = gap(ev.feature_matrix(current.with_effects(**{eff: s_ref})))
                 s_best = min(gaps, key=gaps.get)
             g = gaps[s_best]
@@ -407,6 +440,7 @@ def run(
                 entry["accepted"] = True
         named.append((eff, s_best))
         current = current.with_effects(**{eff: s_best})
+        bar.total += len(seeds)  # evaluated in the round already: counted, not simulated again
         current_fm = ev.feature_matrix(current)
         g_cur = gap(current_fm)
     z1 = zscores(current_fm)
@@ -435,6 +469,7 @@ def run(
         case=case,
     )
     report._spectra = _spectra(measured, model_sim, current, case, dt, seeds[0])
+    bar.update(2)
     return report
 
 

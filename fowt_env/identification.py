@@ -36,6 +36,8 @@ from estimators.order_tracking import rotor_azimuth, rotor_harmonics
 from estimators.preprocess import Preprocessor
 from estimators.ssi_cov import SSICov
 
+from .progress import progress_bar
+
 __all__ = [
     "KIND_MEANING",
     "ROTOR_ORDERS",
@@ -512,6 +514,7 @@ def identify(
     reference: LinearReference | None = None,
     max_freq_rel: float = 0.1,
     rotor_speed: str | np.ndarray | None = "auto",
+    progress: bool | None = False,
 ) -> IdentificationResult:
     """Identify modes of a record with Hankel-DMD and SSI-COV, optionally paired with a linear reference.
 
@@ -558,6 +561,9 @@ def identify(
         ``(n_samples,)`` in rad/s, ``None`` (skip), or ``"auto"`` (default): the ``RotSpeed`` channel if the
         record has one and the rotor turns throughout (a parked or idling record is skipped, with the reason
         in :attr:`IdentificationResult.rotor_speed_source`).
+    progress : bool or None
+        Progress of the steps (band-pass, Hankel-DMD, SSI-COV, order tracking) with an ETA on standard error
+        (:func:`fowt_env.progress.progress_bar`): True, False (default) or None (when it is a terminal).
 
     Returns
     -------
@@ -586,6 +592,28 @@ def identify(
         raise ValueError(f"band: lower corner {lo} Hz must be in (0, Nyquist = {nyq} Hz)")
     hi = min(hi, 0.9 * nyq)
     Y = np.asarray(sub.y, dtype=float)
+    stages = ["band-pass", "Hankel-DMD"] + ["SSI-COV"] * bool(ssi) + ["order tracking"] * (azimuth is not None)
+    with progress_bar(len(stages), "identify", progress=progress) as bar:
+        bar.set_postfix_str(stages[0])
+        res = _identify_steps(Y, sub, names, dt, lo, hi, delays, rank, decimate, ssi, ssi_block_rows, ssi_orders,
+                              speed, azimuth, speed_source, max_freq_rel, stages, bar)
+    if reference is not None:
+        _check_against(res, reference, speed, max_freq_rel)
+    return res
+
+
+def _identify_steps(Y: np.ndarray, sub: Any, names: list[str], dt: float, lo: float, hi: float, delays: int | float,
+                    rank: int | float | str, decimate: bool, ssi: bool, ssi_block_rows: int | None, ssi_orders: Any,
+                    speed: np.ndarray | None, azimuth: np.ndarray | None, speed_source: str, max_freq_rel: float,
+                    stages: list[str], bar: Any) -> IdentificationResult:
+    """:func:`identify`'s computation, advancing ``bar`` after each of ``stages``."""
+
+    def done(k: int) -> None:
+        bar.update(1)
+        if k + 1 < len(stages):
+            bar.set_postfix_str(stages[k + 1])
+
+    nyq = 0.5 / dt
     pre = Preprocessor(fs=1.0 / dt, band=(lo, hi))
     Z = pre.fit_transform(Y)
     filtered_std = pre.std_
@@ -595,8 +623,10 @@ def identify(
     dt_d = dt * q
     if isinstance(delays, float):
         delays = max(1, int(round(delays / dt_d)))
+    done(0)
     dmd = HankelDMD(delays=delays, rank=rank, dt=dt_d).fit(Zd)
     dmd_modes = dmd.mode_table()
+    done(1)
     ssi_est = None
     ssi_modes: list[dict] = []
     if ssi:
@@ -607,35 +637,42 @@ def identify(
                             else ssi_orders)
         ssi_est = SSICov(dt_d, **kwargs).fit(Zd)
         ssi_modes = ssi_est.mode_table()
+        done(2)
     harmonics = None
     if azimuth is not None:
         depths = tuple(sorted({max(2, int(round(f * delays))) for f in (0.8, 1.0, 1.2)}))
         harmonics = rotor_harmonics(Zd, dt_d, azimuth=azimuth[::q], delays=depths, rank=rank)
-    res = IdentificationResult(names, [sub.units[i] for i in range(len(names))], dt, (lo, hi), filtered_std, dmd,
+        done(len(stages) - 1)
+    return IdentificationResult(names, [sub.units[i] for i in range(len(names))], dt, (lo, hi), filtered_std, dmd,
                                ssi_est, dmd_modes, ssi_modes, harmonics=harmonics, rotor_speed_source=speed_source,
                                max_freq_rel=float(max_freq_rel),
                                _rotor_hz=None if speed is None else speed / (2.0 * np.pi), _y=Y,
                                _spectrogram_channel=next((c for c in reversed(names) if c.endswith("ALxt") or
                                                           c.endswith("ALyt")), names[0]))
-    if reference is not None:
-        rows = [reference.channels.index(c) for c in names]
-        ref = LinearReference(reference.frequencies_hz, reference.damping_ratios, reference.shapes[rows],
-                              reference.labels, names, model_modes=reference.model_modes)
-        res.reference = ref
-        bands = None if speed is None else rotor_bands(speed / (2.0 * np.pi))
-        label_against_model(dmd_modes, ref.all_modes(), max_freq_rel, bands)
-        label_against_model(ssi_modes, ref.all_modes(), max_freq_rel, bands)
-        structural = [r["index"] for r in dmd_modes if r["kind"] == "structural"]
-        res.pairs["dmd"] = _pair(ref, np.abs(dmd.frequencies_hz_[structural]), dmd.damping_ratios_[structural],
-                                 dmd.modes_[:, structural] * filtered_std[:, None], max_freq_rel)
-        if ssi_est is not None:
-            kept = [r["index"] for r in ssi_modes if r["kind"] == "structural"]
-            res.pairs["ssi"] = _pair(ref, np.asarray(ssi_est.frequencies_hz_)[kept],
-                                     np.asarray(ssi_est.damping_ratios_)[kept],
-                                     np.asarray(ssi_est.modes_)[:, kept] * filtered_std[:, None], max_freq_rel)
-        for method, table in (("dmd", dmd_modes), ("ssi", ssi_modes)):  # a paired line names its reference mode
-            for pair in res.pairs.get(method, []):
-                for row in table:
-                    if row["kind"] == "structural" and np.isclose(row["frequency_hz"], pair["f"], rtol=1e-12):
-                        row["model_mode"] = pair["label"]
-    return res
+
+
+def _check_against(res: IdentificationResult, reference: LinearReference, speed: np.ndarray | None,
+                   max_freq_rel: float) -> None:
+    """Label ``res``'s mode tables against the model and pair them with ``reference`` (in place)."""
+    names, dmd, ssi_est = res.channels, res.dmd, res.ssi
+    dmd_modes, ssi_modes, filtered_std = res.dmd_modes, res.ssi_modes, res.scale
+    rows = [reference.channels.index(c) for c in names]
+    ref = LinearReference(reference.frequencies_hz, reference.damping_ratios, reference.shapes[rows],
+                          reference.labels, names, model_modes=reference.model_modes)
+    res.reference = ref
+    bands = None if speed is None else rotor_bands(speed / (2.0 * np.pi))
+    label_against_model(dmd_modes, ref.all_modes(), max_freq_rel, bands)
+    label_against_model(ssi_modes, ref.all_modes(), max_freq_rel, bands)
+    structural = [r["index"] for r in dmd_modes if r["kind"] == "structural"]
+    res.pairs["dmd"] = _pair(ref, np.abs(dmd.frequencies_hz_[structural]), dmd.damping_ratios_[structural],
+                             dmd.modes_[:, structural] * filtered_std[:, None], max_freq_rel)
+    if ssi_est is not None:
+        kept = [r["index"] for r in ssi_modes if r["kind"] == "structural"]
+        res.pairs["ssi"] = _pair(ref, np.asarray(ssi_est.frequencies_hz_)[kept],
+                                 np.asarray(ssi_est.damping_ratios_)[kept],
+                                 np.asarray(ssi_est.modes_)[:, kept] * filtered_std[:, None], max_freq_rel)
+    for method, table in (("dmd", dmd_modes), ("ssi", ssi_modes)):  # a paired line names its reference mode
+        for pair in res.pairs.get(method, []):
+            for row in table:
+                if row["kind"] == "structural" and np.isclose(row["frequency_hz"], pair["f"], rtol=1e-12):
+                    row["model_mode"] = pair["label"]

@@ -166,6 +166,7 @@ def sense(
     options: dict[str, Any] | None = None,
     truth: Any = None,
     settings: Any = None,
+    progress: bool | None = False,
 ) -> SensingResult:
     """Reconstruct the lost channels of a measured record with a trained virtual sensor.
 
@@ -193,6 +194,9 @@ def sense(
         Noise-free truth with the same channels, for scores.
     settings : fowt_env.compare.CompareSettings, optional
         Default training set-up (used only without ``train``).
+    progress : bool or None
+        Progress of the steps (training, reconstruction) with an ETA on standard error
+        (:func:`fowt_env.progress.progress_bar`): True, False (default) or None (when it is a terminal).
 
     Returns
     -------
@@ -220,42 +224,49 @@ def sense(
         mask[:, names.index(h)] = False
     if not mask.any():
         raise ValueError("no live data: every sensed channel is lost in every sample")
-    t0 = time.perf_counter()
-    if train:
-        factory = ESTIMATORS[estimator]
-        sensor = factory(measured.dt, update_interval, channels=names, **(options or {}))
-        data = []
-        for i, rec in enumerate(train):
-            miss = [c for c in names if c not in rec]
-            if miss:
-                raise ValueError(f"training record {i} lacks channels {miss}")
-            if abs(rec.dt - measured.dt) > 1e-6 * measured.dt:
-                raise ValueError(f"training record {i} has dt = {rec.dt:g} s, the measurement {measured.dt:g} s")
-            data.append(rec.select(names).y)
-        if getattr(factory, "concatenate_training", False):
-            data = [np.concatenate(data, axis=0)]
-        sensor.fit(data)
-    else:
-        base = settings or CompareSettings()
-        if abs(base.dt - measured.dt) > 1e-6 * base.dt:
-            raise ValueError(f"the measurement has dt = {measured.dt:g} s but the default surrogate training set is "
-                             f"at {base.dt:g} s: resample the record or give training records (--train)")
-        from dataclasses import replace
+    from .progress import progress_bar
 
-        st = replace(base, plane=plane if channels is None else base.plane,
-                     estimator_options={estimator: dict(options or {})} if options else base.estimator_options)
-        if channels is not None and list(channels) != st.channels:
-            raise ValueError("explicit channels need training records (--train); the default training set has "
-                             f"the channels of plane {st.plane!r}")
-        sensor = fit_sensor(estimator, st, update_interval)
-    fit_s = time.perf_counter() - t0
-    y_in = np.where(mask, y, np.nan)
-    t1 = time.perf_counter()
-    try:
-        est, std = sensor.reconstruct(y_in, mask, return_std=True)
-    except TypeError:
-        est, std = sensor.reconstruct(y_in, mask), None
-    wall = time.perf_counter() - t1
+    with progress_bar(2, "sense", progress=progress) as bar:
+        bar.set_postfix_str("training" if train else "training on the surrogate's load cases")
+        t0 = time.perf_counter()
+        if train:
+            factory = ESTIMATORS[estimator]
+            sensor = factory(measured.dt, update_interval, channels=names, **(options or {}))
+            data = []
+            for i, rec in enumerate(train):
+                miss = [c for c in names if c not in rec]
+                if miss:
+                    raise ValueError(f"training record {i} lacks channels {miss}")
+                if abs(rec.dt - measured.dt) > 1e-6 * measured.dt:
+                    raise ValueError(f"training record {i} has dt = {rec.dt:g} s, the measurement {measured.dt:g} s")
+                data.append(rec.select(names).y)
+            if getattr(factory, "concatenate_training", False):
+                data = [np.concatenate(data, axis=0)]
+            sensor.fit(data)
+        else:
+            base = settings or CompareSettings()
+            if abs(base.dt - measured.dt) > 1e-6 * base.dt:
+                raise ValueError(f"the measurement has dt = {measured.dt:g} s but the default surrogate training set "
+                                 f"is at {base.dt:g} s: resample the record or give training records (--train)")
+            from dataclasses import replace
+
+            st = replace(base, plane=plane if channels is None else base.plane,
+                         estimator_options={estimator: dict(options or {})} if options else base.estimator_options)
+            if channels is not None and list(channels) != st.channels:
+                raise ValueError("explicit channels need training records (--train); the default training set has "
+                                 f"the channels of plane {st.plane!r}")
+            sensor = fit_sensor(estimator, st, update_interval)
+        fit_s = time.perf_counter() - t0
+        bar.update(1)
+        bar.set_postfix_str("reconstruct")
+        y_in = np.where(mask, y, np.nan)
+        t1 = time.perf_counter()
+        try:
+            est, std = sensor.reconstruct(y_in, mask, return_std=True)
+        except TypeError:
+            est, std = sensor.reconstruct(y_in, mask), None
+        wall = time.perf_counter() - t1
+        bar.update(1)
     units = list(measured.select(names).units)
     meta = {"source": "fowt-env sense", "estimator": estimator, "measured_meta": measured.meta,
             "lost_fraction": {n: float(1 - mask[:, j].mean()) for j, n in enumerate(names)}}

@@ -1249,7 +1249,7 @@ def validate(
     plot_dir: str | os.PathLike[str] | None = None,
     plot_channels: Sequence[str] = PLOT_CHANNELS,
     base_seed: int = 0,
-    progress: bool = False,
+    progress: bool | None = False,
 ) -> ValidationReport:
     """Compare the surrogate with OpenFAST reference runs, channel by channel.
 
@@ -1281,8 +1281,9 @@ def validate(
         Channels of the operating figures.
     base_seed : int
         First seed when `seeds` is a count.
-    progress : bool
-        Show a tqdm progress bar on stderr.
+    progress : bool or None
+        Progress in runs with an ETA on stderr (:func:`fowt_env.progress.progress_bar`): True, False (default) or
+        None (when stderr is a terminal).
 
     Returns
     -------
@@ -1299,9 +1300,9 @@ def validate(
     ``transient_s`` (100 s), the decays with ``transient=0`` from ``initial`` (OpenFAST channel names and units).
     The seeds of one run are simulated in parallel threads by :func:`surrogates.simulate`.
     """
-    from tqdm.auto import tqdm
-
     import surrogates
+
+    from .progress import progress_bar
 
     t_start = time.perf_counter()
     if model is None:  # the gauges where the reference deck has them (TwrGagNd of the shared runs)
@@ -1327,8 +1328,9 @@ def validate(
     has_initial = _simulate_supports_initial()
     figs: list[str] = []
     plot_path = None if plot_dir is None else Path(plot_dir)
-    bar = tqdm(ref_runs, desc="validate", unit="run", disable=not progress, leave=False)
-    for run in bar:
+    bar = progress_bar(len(ref_runs), "validate", unit="runs", progress=progress)
+    for k, run in enumerate(ref_runs):
+        bar.update(1 if k else 0)  # k runs done
         bar.set_postfix_str(run.name)
         case = surrogate_case(_with_measured_inputs(run))
         report.runs.append({"name": run.name, "kind": run.kind, "case": run.case, "source": run.source,
@@ -1357,6 +1359,7 @@ def validate(
                 p = _plot_operating(run, sims, plot_path / f"{run.name}.png", plot_channels)
                 if p is not None:
                     figs.append(str(p))
+    bar.update(1 if ref_runs else 0)
     bar.close()
     report.figures = figs
     report.elapsed_s = time.perf_counter() - t_start

@@ -1,0 +1,164 @@
+"""Progress of long steps, shown with a total and an ETA on a terminal and nowhere else.
+
+One helper for every long step of the library and the command line (identification, the discrepancy search,
+sensing, comparisons, campaigns, validation, episodes): a `tqdm <https://tqdm.github.io>`_ bar on standard
+error that
+
+* appears only on a terminal (``progress=None``, the command line's choice) or when asked (``progress=True``);
+  piped or redirected output carries no bars, no carriage returns;
+* appears, on a terminal, only once the step has run for :data:`DEFAULT_DELAY_S` seconds (2 s; the environment
+  variable ``FOWT_ENV_PROGRESS_DELAY`` sets another delay, 0 = at once), so quick steps stay quiet; a bar asked
+  for explicitly (``progress=True``) appears at once;
+* always shows the done/total count and the estimated time left, ``ETA mm:ss``, and is erased when the step ends.
+
+Examples
+--------
+>>> from fowt_env.progress import progress_bar
+>>> with progress_bar(3, "fitting", progress=False) as bar:
+...     for _ in range(3):
+...         bar.update(1)
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from typing import IO, Any
+
+__all__ = ["BAR_FORMAT", "DEFAULT_DELAY_S", "DELAY_ENV", "delay_s", "on_terminal", "progress_bar", "resolve"]
+
+#: Seconds a step runs before its bar appears.
+DEFAULT_DELAY_S: float = 2.0
+#: Environment variable overriding :data:`DEFAULT_DELAY_S` (seconds, >= 0).
+DELAY_ENV: str = "FOWT_ENV_PROGRESS_DELAY"
+#: Done/total and the time left spelt out (tqdm's default writes the ETA as ``<mm:ss``).
+BAR_FORMAT: str = ("{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} {unit} "
+                   "[{elapsed} elapsed, ETA {remaining}{postfix}]")
+
+
+def on_terminal(stream: IO[str] | None = None) -> bool:
+    """Whether ``stream`` (default standard error) is a terminal.
+
+    Parameters
+    ----------
+    stream : text stream, optional
+        The stream the bar would be written to (default ``sys.stderr``).
+
+    Returns
+    -------
+    bool
+    """
+    stream = sys.stderr if stream is None else stream
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError):  # no isatty, or a closed stream
+        return False
+
+
+def resolve(progress: bool | None, stream: IO[str] | None = None) -> bool:
+    """The ``progress`` argument of the library's long functions as a yes/no.
+
+    Parameters
+    ----------
+    progress : bool or None
+        True: show; False: do not; None: show when ``stream`` is a terminal.
+    stream : text stream, optional
+        Default standard error.
+
+    Returns
+    -------
+    bool
+    """
+    return on_terminal(stream) if progress is None else bool(progress)
+
+
+def delay_s() -> float:
+    """Seconds a step runs before its bar appears: ``$FOWT_ENV_PROGRESS_DELAY`` if it is a number >= 0, else
+    :data:`DEFAULT_DELAY_S`.
+
+    Returns
+    -------
+    float
+    """
+    text = os.environ.get(DELAY_ENV, "").strip()
+    try:
+        value = float(text)
+    except ValueError:
+        return DEFAULT_DELAY_S
+    return value if value >= 0 else DEFAULT_DELAY_S
+
+
+def progress_bar(total: float | None, desc: str, *, unit: str = "steps", progress: bool | None = None,
+                 initial: float = 0, leave: bool = False, stream: IO[str] | None = None, tick_s: float = 1.0) -> Any:
+    """A progress bar with a total and an ETA, or a silent stand-in with the same methods.
+
+    Parameters
+    ----------
+    total : float or None
+        Units of work in the step (None: unknown, then no ETA can be given; avoid).
+    desc : str
+        What is running (``"identify"``, ``"discrepancy"``...).
+    unit : str
+        Name of the unit of work, plural (``"steps"``, ``"simulations"``, ``"tasks"``).
+    progress : bool or None
+        True: show at once; False: silent; None (default): show when ``stream`` is a terminal, once the step has
+        run for :func:`delay_s` seconds.
+    initial : float
+        Work already done (a resumed campaign).
+    leave : bool
+        Keep the finished bar on screen (default: erase it).
+    stream : text stream, optional
+        Default standard error.
+    tick_s : float
+        Redraw the bar this often (s) while one unit of work runs, so that a long unit still shows the time
+        going by; 0: redraw only on updates.
+
+    Returns
+    -------
+    tqdm.tqdm
+        ``update(n)``, ``set_postfix_str(text)``, ``close()``, a context manager; the total may grow
+        (``bar.total += n; bar.refresh()``) when later work becomes known.
+    """
+    stream = sys.stderr if stream is None else stream
+    return _bar_class()(total=total, desc=desc, unit=unit, initial=initial, file=stream,
+                        disable=not resolve(progress, stream), leave=leave,
+                        delay=delay_s() if progress is None else 0.0, dynamic_ncols=True,
+                        smoothing=0.1, bar_format=BAR_FORMAT if total is not None else None, mininterval=0.2,
+                        tick_s=tick_s)
+
+
+_BAR: type | None = None
+
+
+def _bar_class() -> type:
+    """tqdm with a redraw thread (built on first use: importing this module does not import tqdm)."""
+    global _BAR
+    if _BAR is not None:
+        return _BAR
+    import threading
+
+    from tqdm import tqdm
+
+    class _TickingBar(tqdm):  # type: ignore[misc,valid-type]
+        """tqdm that redraws every ``tick_s`` seconds once its delay has passed (elapsed time and ETA move on
+        while a long unit of work runs)."""
+
+        def __init__(self, *args: Any, tick_s: float = 1.0, **kwargs: Any) -> None:
+            super().__init__(*args, **kwargs)
+            self._stop = threading.Event()
+            if not self.disable and tick_s > 0:
+                threading.Thread(target=self._tick, args=(float(tick_s),), daemon=True).start()
+
+        def _tick(self, tick_s: float) -> None:
+            while not self._stop.wait(tick_s):
+                if not self.disable and self._time() - self.start_t >= self.delay:
+                    self.refresh()
+
+        def close(self) -> None:
+            stop = getattr(self, "_stop", None)
+            if stop is not None:
+                stop.set()
+            super().close()
+
+    _BAR = _TickingBar
+    return _BAR

@@ -1,0 +1,141 @@
+"""Long steps show progress with a total and an ETA on a terminal, and nothing when piped (issue 19 item 3)."""
+
+import fcntl
+import io
+import os
+import pty
+import re
+import select
+import struct
+import subprocess
+import sys
+import termios
+import time
+
+import pytest
+
+import surrogates
+from fowt_env import discrepancy
+from fowt_env.progress import DELAY_ENV, delay_s, progress_bar
+
+# "identify:  50%|#####     | 2/4 steps [00:01 elapsed, ETA 00:01, SSI-COV]"
+_BAR = re.compile(r"identify: +\d+%\|[^|]*\| (\d+)/(\d+) steps \[(\d\d:\d\d) elapsed, ETA (\d\d:\d\d|\?)")
+
+
+@pytest.fixture(scope="module")
+def record(tmp_path_factory):
+    path = tmp_path_factory.mktemp("progress") / "olc7.npz"
+    surrogates.simulate(surrogates.FOWTModel(), 7, duration=120.0, seed=3).save(path)
+    return path
+
+
+def _identify_argv(path) -> list[str]:
+    return [sys.executable, "-m", "fowt_env.cli", "identify", str(path), "--plane", "FA", "--no-reference"]
+
+
+def _env() -> dict[str, str]:
+    return {**os.environ, DELAY_ENV: "0", "COLUMNS": "120"}  # the bar at once: the step need not last 2 s here
+
+
+def _run_on_a_terminal(argv: list[str], timeout: float = 300.0) -> tuple[int, str]:
+    """Run ``argv`` with stdout and stderr on a pseudo-terminal (120 x 40); its return code and all it wrote."""
+    master, slave = pty.openpty()
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 40, 120, 0, 0))
+    proc = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=slave, stderr=slave, env=_env(), close_fds=True)
+    os.close(slave)
+    chunks = []
+    deadline = time.monotonic() + timeout
+    try:
+        while time.monotonic() < deadline:
+            ready, _, _ = select.select([master], [], [], 0.5)
+            if ready:
+                try:
+                    data = os.read(master, 65536)
+                except OSError:  # EIO: the child closed the terminal
+                    break
+                if not data:
+                    break
+                chunks.append(data)
+            elif proc.poll() is not None:
+                break
+        code = proc.wait(timeout=max(1.0, deadline - time.monotonic()))
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        os.close(master)
+    return code, b"".join(chunks).decode("utf-8", "replace")
+
+
+def test_identify_on_a_terminal_shows_the_total_and_an_eta(record):
+    code, out = _run_on_a_terminal(_identify_argv(record))
+    assert code == 0, out
+    bars = _BAR.findall(out)
+    assert bars, out
+    # band-pass, Hankel-DMD, SSI-COV, order tracking (the record has RotSpeed)
+    assert {total for _, total, _, _ in bars} == {"4"}
+    assert any(eta != "?" for *_, eta in bars), bars  # a time left, once a step is done
+    assert [int(n) for n, *_ in bars] == sorted(int(n) for n, *_ in bars)
+    assert "Hankel-DMD: delays" in out  # and the results, after the bar
+
+
+def test_identify_piped_has_no_progress(record):
+    proc = subprocess.run(_identify_argv(record), capture_output=True, text=True, env=_env(), timeout=300,
+                          stdin=subprocess.DEVNULL)
+    assert proc.returncode == 0, proc.stderr
+    assert "Hankel-DMD: delays" in proc.stdout
+    for stream in (proc.stdout, proc.stderr):
+        assert "ETA" not in stream and "\r" not in stream and "%|" not in stream
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_progress_bar_shows_only_on_a_terminal_and_only_after_its_delay(monkeypatch):
+    monkeypatch.setenv(DELAY_ENV, "0")
+    tty, pipe = _Terminal(), io.StringIO()
+    for stream in (tty, pipe):
+        with progress_bar(3, "work", stream=stream) as bar:
+            bar.update(3)
+    assert "/3 steps" in tty.getvalue() and "ETA" in tty.getvalue()
+    assert pipe.getvalue() == ""
+    forced = io.StringIO()  # asked for explicitly: shown, at once, on any stream
+    with progress_bar(2, "work", unit="runs", progress=True, stream=forced) as bar:
+        bar.update(2)
+    assert "/2 runs" in forced.getvalue()
+    monkeypatch.setenv(DELAY_ENV, "30")
+    quick = _Terminal()
+    with progress_bar(3, "work", stream=quick) as bar:  # done long before its delay: never drawn
+        bar.update(3)
+    assert quick.getvalue() == ""
+
+
+@pytest.mark.parametrize(("text", "expected"), [("", 2.0), ("0", 0.0), ("0.5", 0.5), ("-1", 2.0), ("soon", 2.0)])
+def test_delay_from_the_environment(monkeypatch, text, expected):
+    monkeypatch.setenv(DELAY_ENV, text)
+    assert delay_s() == expected
+
+
+def test_discrepancy_progress_counts_every_simulation_it_runs(capsys, monkeypatch):
+    """The total the bar announces is the work done: it ends at n == total (the ETA was honest)."""
+    bars = []
+
+    def keep(*args, **kwargs):
+        bars.append(progress_bar(*args, **kwargs))
+        return bars[-1]
+
+    monkeypatch.setattr(discrepancy, "progress_bar", keep)
+    model = surrogates.FOWTModel()
+    measured = surrogates.simulate(model.without("mooring_nonlinear"), 7, duration=150.0, seed=4, dt=0.05)
+    rep = discrepancy.run(measured, model, 7, candidates=["mooring_nonlinear"], n_seeds=3, n_scatter=4,
+                          strengths=(0.0, 0.5, 1.5), max_effects=1, progress=True)
+    err = capsys.readouterr().err
+    assert re.search(r"discrepancy: +\d+%\|[^|]*\| \d+/\d+ simulations \[", err), err
+    (bar,) = bars
+    assert bar.n == bar.total
+    # base (3 seeds) + extra scatter seed (1) + 3 strengths other than the model's 1.0 x 3 seeds (+ 3 if the
+    # parabola refines the best) + 2 spectra
+    assert bar.total in (3 + 1 + 9 + 2, 3 + 1 + 12 + 2)
+    assert rep.gap_before >= 0
