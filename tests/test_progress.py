@@ -25,7 +25,7 @@ _BAR = re.compile(r"identify: +\d+%\|[^|]*\| (\d+)/(\d+) steps \[(\d\d:\d\d) ela
 @pytest.fixture(scope="module")
 def record(tmp_path_factory):
     path = tmp_path_factory.mktemp("progress") / "olc7.npz"
-    surrogates.simulate(surrogates.FOWTModel(), 7, duration=120.0, seed=3).save(path)
+    surrogates.simulate(surrogates.FOWTModel(), 7, duration=60.0, seed=3).save(path)
     return path
 
 
