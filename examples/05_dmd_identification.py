@@ -36,10 +36,11 @@ What to look for.
 * The 3P forcing (blade passing, three times the rotor speed) is a *band* in time: the rotor speed follows the
   turbulence, so the line wanders (the spectrogram shows it, with its 3P track drawn over it), and SSI-COV
   finds a heavily damped line near 0.59 Hz (7-9 % damping, ``rotor_band (3P)``) in both planes, where the seed
-  paper reported a side-to-side "mode" at 0.638 Hz / 10.6 %. Order tracking (resampling at equal rotor-azimuth steps, using the
-  ``RotSpeed`` channel) turns every rotor-locked load into a line again, but in this turbulent case the "Rotor
-  harmonics" table is empty: most of the 3P content is the blades' rotational sampling of the turbulence, which
-  has no fixed phase to the azimuth (order tracking finds no line in OpenFAST's turbulent 12 m/s run either).
+  paper reported a side-to-side "mode" at 0.638 Hz / 10.6 %. Order tracking (resampling at equal rotor-azimuth
+  steps, using the ``RotSpeed`` channel) turns every rotor-locked load into a line again, but in this turbulent
+  case the "Rotor harmonics" table is empty: most of the 3P content is the blades' rotational sampling of the
+  turbulence, which has no fixed phase to the azimuth (order tracking finds no line in OpenFAST's turbulent
+  12 m/s run either).
   In steady wind (turbulence intensity 0) the same table lists order 3.00 and 6.00, undamped and phase-locked
   (locking ~1), in the fore-aft plane (main README, Identification).
 * ``--quick`` (4 minutes instead of 30) still finds the 1st modes, with more scatter.
