@@ -255,7 +255,9 @@ def test_paper_scenarios_on_surrogate_data():
     # moment TwHt9MLyt is driven by the rotor's tilt moment from rotationally sampled turbulence, which the other
     # channels barely see (the same 0.76-0.83 as test_paper_scenarios_on_short_surrogate_data). Must not get worse
     # (measured minus about 0.01-0.02); the shortfall is reported as an expected failure.
-    floors = {"A": (0.93, 0.91), "B": (0.945, 0.78), "C": (0.90, 0.76)}  # (median, min)
+    # Since the rotor's aerodynamic tilt damping (issue 15; the tower responds less modally, the nacelle moment
+    # carries the damping moment) measured: A median 0.918 / min 0.650, B 0.954 / 0.561, C 0.878 / 0.504.
+    floors = {"A": (0.90, 0.62), "B": (0.94, 0.53), "C": (0.86, 0.47)}  # (median, min)
     for name, (med, low) in floors.items():
         assert np.median(results[name]) >= med and results[name].min() >= low, name
     missed = [name for name, r2 in results.items() if not (np.median(r2) >= 0.95 and r2.min() >= 0.85)]

@@ -523,7 +523,8 @@ def test_paper_scenarios_on_surrogate_data():
     # accelerometers (and moments) at gauges 3, 4, 6, 8: without gravity (OpenFAST's definition) the accelerations no
     # longer carry the platform pitch angle, and the hidden ones measure 0.945-0.981 (moments >= 0.9987; median 0.990).
     # In B and C the top accelerometer (TwHt9ALxt) reaches 0.9969 and 0.9940 (medians 0.9993, 0.9989).
-    assert np.median(results["A"]) >= 0.985 and results["A"].min() >= 0.93
+    # (with the rotor's aerodynamic tilt damping, issue 15: A median 0.987, min 0.907)
+    assert np.median(results["A"]) >= 0.985 and results["A"].min() >= 0.89
     for name in "BC":
         assert np.median(results[name]) >= 0.998 and results[name].min() >= 0.99, name
 
