@@ -525,8 +525,8 @@ def test_paper_scenarios_on_surrogate_data():
     # In B and C the top accelerometer (TwHt9ALxt) reaches 0.9969 and 0.9940 (medians 0.9993, 0.9989).
     # (with the rotor's aerodynamic tilt damping, issue 15: A median 0.987, min 0.907)
     assert np.median(results["A"]) >= 0.985 and results["A"].min() >= 0.89
-    for name in "BC":
-        assert np.median(results[name]) >= 0.998 and results[name].min() >= 0.99, name
+    for name in "BC":  # (with the rotor's aerodynamic tilt damping: B 0.9986 / 0.9966, C 0.9978 / 0.9914)
+        assert np.median(results[name]) >= 0.997 and results[name].min() >= 0.99, name
 
 
 @pytest.mark.slow
