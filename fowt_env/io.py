@@ -958,6 +958,8 @@ def _read_csv_columns(path: Path) -> list[_Column]:
     head = lines[0]
     delimiter = "," if "," in head else ";" if ";" in head else "\t" if "\t" in head else ","
     rows = [r for r in csv.reader(lines, delimiter=delimiter) if any(cell.strip() for cell in r)]
+    if not rows:  # e.g. a lone delimiter: no cell holds anything
+        raise ValueError("has no header row (no non-empty cells)")
     header = [h.strip() for h in rows[0]]
     body = rows[1:]
     file_units: list[str | None] = [None] * len(header)
