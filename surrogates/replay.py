@@ -70,7 +70,7 @@ from scipy.fft import irfft, next_fast_len, rfft
 
 from .oc3 import WATER_DEPTH
 from .validation import check_number
-from .waves import SparGeometry, WaveLoads, _along_loads, _kernels, wave_number
+from .waves import SparGeometry, WaveLoads, _wave_transfer_rows
 from .wind import rotor_averaging, rotor_plane_fit
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -264,14 +264,7 @@ class MeasuredWaves:
         up = max(1, int(math.ceil(self.dt / step_out - 1e-9)))
 
         def transfer(f: np.ndarray) -> np.ndarray:
-            f_along, m_along, fz = _along_loads(f, depth, geo, None)
-            w = 2.0 * np.pi * f
-            horizontal, _ = _kernels(wave_number(w, depth), z, depth)
-            rows = np.empty((4 + z.size, f.size), dtype=complex)
-            rows[0] = 1.0
-            rows[1], rows[2], rows[3] = f_along, m_along, fz
-            rows[4:] = (w[:, None] * horizontal).T
-            return rows
+            return _wave_transfer_rows(f, depth, geo, z)
 
         fine = _fft_filter(self.elevation, self.dt, transfer, self.taper_s, up, (self.f_min_hz, self.f_max_hz))
         t_fine = self.t[0] + np.arange(fine.shape[0]) * (self.dt / up)

@@ -393,6 +393,19 @@ def _along_loads(
     return f_along, m_along, (RHO_WATER * GRAVITY) * fz.astype(complex)
 
 
+def _wave_transfer_rows(f: np.ndarray, depth: float, geo: SparGeometry, z: np.ndarray) -> np.ndarray:
+    """Transfer functions per unit wave amplitude, one row each: elevation, F_along, M_along, Fz and the
+    horizontal particle velocity at each strip height ``z``; shape (4 + len(z), len(f))."""
+    f_along, m_along, fz = _along_loads(f, depth, geo, None)
+    w = 2.0 * np.pi * f
+    horizontal, _ = _kernels(wave_number(w, depth), z, depth)
+    rows = np.empty((4 + z.size, f.size), dtype=complex)
+    rows[0] = 1.0
+    rows[1], rows[2], rows[3] = f_along, m_along, fz
+    rows[4:] = (w[:, None] * horizontal).T
+    return rows
+
+
 def excitation_rao(
     f_hz: np.ndarray,
     direction_deg: float = 0.0,
@@ -598,14 +611,7 @@ def synthesize_waves(
     fa = freqs[active]
     amp = np.sqrt(2.0 * spec[active] * df) * np.exp(1j * phases[active])
 
-    # transfer functions per unit amplitude: elevation, F_along, M_along, Fz, velocity at each strip
-    f_along, m_along, fz = _along_loads(fa, depth, geo, None)
-    w = 2.0 * np.pi * fa
-    horizontal, _ = _kernels(wave_number(w, depth), z, depth)
-    rows = np.empty((4 + z.size, active.size), dtype=complex)
-    rows[0] = 1.0
-    rows[1], rows[2], rows[3] = f_along, m_along, fz
-    rows[4:] = (w[:, None] * horizontal).T
+    rows = _wave_transfer_rows(fa, depth, geo, z)
     # irfft gives (1/N) sum_j X_j e^{2 pi i j m / N} + c.c., so N/2 X_j makes sum_j Re(X_j e^{i w_j t}); bins
     # above the last active one are zero-padded by irfft itself
     n_used = int(active[-1]) + 1 if active.size else 1
