@@ -340,10 +340,14 @@ def _uniform_grid(t_raw: NDArray[np.float64], resolution: float | NDArray[np.flo
     # "0.025" are not 0.012 s steps printed to 1 ms. Printed (quantised) stamps snap within their resolution to
     # a step of at most two more decimals than printed and within 3 standard errors of the fitted step: 1 ms
     # stamps of 60 Hz data are not 0.016667 s steps, 0.1 ms stamps of 160 Hz data are 0.00625 s steps.
-    snap = np.full(n, noise) if exact else half
+    # Snapping allows only the rounding of ``t0 + k dt`` itself (2 ulps), not the screening margin `noise`
+    # (8 ulps): with that margin two stamps 1234.0 and 1234.00152439024390 (656 Hz) snapped to a step of
+    # 0.00152439024 s, 2.6e-9 relative off the true one.
+    fine = 2.0 * float(np.finfo(np.float64).eps) * max(t_abs, dt_med)
+    snap = np.full(n, fine) if exact else np.minimum(0.5 * res, 0.3 * dt_med) + fine
     ok = exact or fits(dt, half)[0]
     if exact:
-        max_digits, max_shift = 16, 2.0 * noise / (n - 1)
+        max_digits, max_shift = 16, 2.0 * fine / (n - 1)
     else:
         printed = res[res > 0.0]
         max_digits = 16 if printed.size == 0 else int(round(-math.log10(float(np.median(printed))))) + 2
@@ -772,8 +776,11 @@ def _write_openfast_text(record: Record, tmp: Path, names: list[str], units: lis
     t = record.t
     dt = record.dt
     decimals = 15
-    for d in range(4, 16):  # enough digits that a reader recovers dt to float precision, not only to 0.01 %
-        if float(np.max(np.abs(t - np.round(t, d)))) <= max(1e-12 * dt, _float_noise(float(np.max(np.abs(t))), dt)):
+    # enough digits that every stamp reads back to within an ulp or two of the float written, which a reader
+    # takes as exact (a margin of 8 ulps let 2816.002525252525 s print as 2816.00252525253 and read 5e-12 s off)
+    one_ulp = float(np.finfo(np.float64).eps) * max(float(np.max(np.abs(t))), dt)
+    for d in range(4, 16):
+        if float(np.max(np.abs(t - np.round(t, d)))) <= one_ulp:
             decimals = d
             break
     width = max(10, decimals + 6)
