@@ -41,11 +41,13 @@ from __future__ import annotations
 
 import contextlib
 import copy
+import errno
 import json
 import math
 import os
 import uuid
 import zipfile
+import zlib
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -459,14 +461,20 @@ class Record:
         """
         dest = Path(path)
         header = np.array(self._header(), dtype=np.str_)
+        if dest.is_dir():
+            raise IsADirectoryError(errno.EISDIR, "is a directory; give a file name", str(dest))
+        if not dest.parent.is_dir():
+            raise FileNotFoundError(errno.ENOENT, f"its directory {str(dest.parent)!r} does not exist", str(dest))
         tmp = dest.with_name(f".{dest.name}.{uuid.uuid4().hex}.tmp")
         try:
             with open(tmp, "xb") as fh:
                 np.savez_compressed(fh, t=self._t, y=self._y, header=header)
             os.replace(tmp, dest)
-        except BaseException:
+        except BaseException as exc:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
+            if isinstance(exc, OSError) and exc.errno is not None:  # name the destination, not the hidden file
+                raise type(exc)(exc.errno, exc.strerror, str(dest)) from None
             raise
         return dest
 
@@ -487,19 +495,24 @@ class Record:
         Raises
         ------
         FileNotFoundError
-            If `path` does not exist.
+            If `path` does not exist (``IsADirectoryError`` if it is a directory); one line naming it.
         ValueError
-            If the file is not a record archive (wrong members, object arrays, a bad or foreign header, or a
-            newer format version).
+            If the file is not a record archive (wrong members, object arrays, a bad or foreign header, a newer
+            format version, or corrupt compressed data); one line naming it.
         """
         path = Path(path)
-        unreadable = (ValueError, OSError, EOFError, zipfile.BadZipFile)
+        if not path.exists():
+            raise FileNotFoundError(errno.ENOENT, "no such file", str(path))
+        if path.is_dir():
+            raise IsADirectoryError(errno.EISDIR, "is a directory, not a record file", str(path))
+        unreadable = (ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error)
         # Open the file ourselves so that it is closed on every path (np.load leaks it on a corrupt zip).
         with open(path, "rb") as fh:
             try:
                 loaded = np.load(fh, allow_pickle=False)
             except unreadable as exc:
-                raise ValueError(f"{path} is not a Record file (.npz written by Record.save): {exc}") from None
+                raise ValueError(f"{path} is not a Record file (.npz written by Record.save): "
+                                 f"{' '.join(str(exc).split())}") from None
             if not isinstance(loaded, np.lib.npyio.NpzFile):
                 raise ValueError(f"{path} is not a Record file: it holds a single array, not an .npz archive")
             with loaded:
@@ -511,7 +524,8 @@ class Record:
                 try:
                     t, y, header_arr = loaded["t"], loaded["y"], loaded["header"]
                 except unreadable as exc:
-                    raise ValueError(f"{path} is not a readable Record file: {exc}") from None
+                    what = f"corrupt compressed data ({exc})" if isinstance(exc, zlib.error) else str(exc)
+                    raise ValueError(f"{path} is not a readable Record file: {' '.join(what.split())}") from None
         if header_arr.ndim != 0 or header_arr.dtype.kind != "U":
             raise ValueError(f"{path} is not a Record file: 'header' is not a 0-d unicode array")
         try:

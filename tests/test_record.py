@@ -282,6 +282,43 @@ def test_load_rejects_corrupt_zip(tmp_path):
         Record.load(path)
 
 
+@pytest.mark.parametrize("offset", [40, 200, 600])
+def test_load_of_corrupt_compressed_data_is_one_line(tmp_path, offset):
+    """A damaged deflate stream (zlib.error) or CRC inside the archive: one line naming the file (issue 18)."""
+    path = make_record(n=400).save(tmp_path / "r.npz")
+    raw = bytearray(path.read_bytes())
+    start = raw.find(b"y.npy") + offset
+    raw[start:start + 40] = bytes(b ^ 0xFF for b in raw[start:start + 40])
+    path.write_bytes(bytes(raw))
+    with pytest.raises(ValueError) as err:
+        Record.load(path)
+    text = str(err.value)
+    assert str(path) in text and "\n" not in text and "Traceback" not in text
+
+
+def test_load_and_save_errors_are_one_line_and_name_the_path_not_the_temporary_file(tmp_path, monkeypatch):
+    rec = make_record(n=20)
+    (tmp_path / "adir").mkdir()
+    cases = [(lambda: Record.load(tmp_path / "missing.npz"), FileNotFoundError, "no such file"),
+             (lambda: Record.load(tmp_path / "adir"), IsADirectoryError, "is a directory"),
+             (lambda: rec.save(tmp_path / "nodir" / "r.npz"), FileNotFoundError, "does not exist"),
+             (lambda: rec.save(tmp_path / "adir"), IsADirectoryError, "is a directory")]
+    for call, kind, words in cases:
+        with pytest.raises(kind) as err:
+            call()
+        text = str(err.value)
+        assert words in text and ".tmp" not in text and "\n" not in text, text
+
+    def refuse(src, dst):
+        raise PermissionError(13, "Permission denied", str(src))
+
+    monkeypatch.setattr("surrogates.record.os.replace", refuse)
+    with pytest.raises(PermissionError) as err:
+        rec.save(tmp_path / "r.npz")
+    assert str(tmp_path / "r.npz") in str(err.value) and ".tmp" not in str(err.value)
+    assert [f.name for f in tmp_path.iterdir()] == ["adir"]  # the temporary file is gone
+
+
 # ---------------------------------------------------------------- property test
 _names = st.lists(
     st.text(min_size=1, max_size=12),
