@@ -363,6 +363,11 @@ class FOWTModel:
         """The linearised structure (shared, cached)."""
         return build_structure()
 
+    def _drag_strips(self) -> DragStrips:
+        """The spar's Morison drag strips before their linearisation about a load case (a subclass that changes the
+        drag coefficient overrides this, as :class:`surrogates.parameters.ParametricModel` does)."""
+        return drag_strips()
+
     # -------------------------------------------------------------------------------------- state space
     def system(self, case: int | LoadCase | None = None) -> LinearSystem:
         """Continuous-time state-space system at a load case (cached per case).
@@ -476,7 +481,7 @@ class FOWTModel:
 
         # the Morison drag's equivalent linearisation about this load case's stationary response (sea state and
         # turbulence), solved by iteration on the linear model's own relative velocity (as RAFT does)
-        drag = drag_strips()
+        drag = self._drag_strips()
         if lc is not None and (lc.hs > 0 or (lc.wind_speed > 0 and lc.turbulence_intensity > 0)):
             if nonlinear_rotor:  # the same linearisation as the linear-rotor model of this case
                 drag = self._system(lc, nonlinear_rotor=False).drag
