@@ -90,9 +90,12 @@ def _parse_effects(spec: str | None) -> str | dict[str, float]:
         return spec or "all"
     out: dict[str, float] = {}
     for item in spec.split(","):
-        name, _, value = item.partition("=")
+        name, eq, value = item.partition("=")
+        if not (eq and name.strip() and value.strip()):
+            raise _UsageError(f"--effects: expected 'all', 'none' or NAME=STRENGTH,... (e.g. quadratic_drag=0.5), "
+                              f"got {item!r}")
         try:
-            out[name.strip()] = float(value) if value else 1.0
+            out[name.strip()] = float(value)
         except ValueError:
             raise _UsageError(f"--effects: strength of {name!r} is not a number: {value!r}") from None
     return out
@@ -116,6 +119,8 @@ def _save_record(rec, path: str | Path) -> Path:
     """Save by extension (.npz, .out, .outb, .csv, .parquet; none = .npz) via :func:`fowt_env.io.save_record`."""
     from .io import save_record
 
+    if str(path).endswith(("/", "\\")) or Path(path).is_dir():
+        raise _UsageError(f"--out: {str(path)!r} names a directory; give a file name, e.g. {Path(path) / 'run.npz'}")
     path = Path(path)
     return save_record(rec, path if path.suffix else path.with_suffix(".npz"))
 
@@ -685,6 +690,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="fowt-env", description=__doc__.split("Examples")[0].strip().replace("``", ""),
                 epilog="Examples:\n" + __doc__.split("::")[1])
     p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    p.add_argument("--debug", action="store_true", help="show the full traceback of a failure")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
     p.subcommands = sub.choices  # type: ignore[attr-defined]
     seed_help = "seed of waves, wind, rotor azimuth and sensor noise (same seed, same record)"
@@ -928,12 +934,52 @@ def main(argv: list[str] | None = None) -> int:
     if extra:  # argparse would blame the top-level parser; the misspelt option belongs to the subcommand
         command.error(f"unrecognized arguments: {' '.join(extra)}")
     try:
+        _check_output_folders(args)
         return int(args.func(args))
     except _UsageError as exc:
         command.error(str(exc))
     except ValueError as exc:
+        if args.debug:
+            raise
         print(f"fowt-env {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except (OSError, MemoryError, ArithmeticError) as exc:  # failures, not usage errors: one line, status 1
+        if args.debug:
+            raise
+        print(f"fowt-env {args.command}: error: {_failure_text(exc, args)}", file=sys.stderr)
+        return 1
+
+
+def _check_output_folders(args: argparse.Namespace) -> None:
+    """An output file (``--json``; ``--out`` of simulate, episode, sense) must go to an existing, writable folder:
+    found before the work, not after it (compare and campaign create the folders they write to)."""
+    import os
+
+    names = ["out"] if args.command in ("simulate", "episode", "sense") else []
+    names += ["json"] if args.command not in ("compare", "campaign") else []
+    for name in names:
+        value = getattr(args, name, None)
+        if value is None:
+            continue
+        folder = Path(value).parent
+        if not folder.is_dir():
+            raise _UsageError(f"--{name}: the folder {str(folder)!r} of {str(value)!r} does not exist")
+        if not os.access(folder, os.W_OK):
+            raise _UsageError(f"--{name}: the folder {str(folder)!r} of {str(value)!r} is not writable")
+
+
+def _failure_text(exc: BaseException, args: argparse.Namespace) -> str:
+    """One line for a failure of the machine or the numbers (a file that cannot be written, too little memory,
+    a diverged simulation)."""
+    if isinstance(exc, OSError) and exc.filename is not None and exc.strerror:
+        return f"{exc.filename}: {exc.strerror or exc}"
+    if isinstance(exc, MemoryError):
+        return ("not enough memory for this request (a shorter --duration or a larger --dt needs less)"
+                f"{': ' + str(exc).splitlines()[0] if str(exc) else ''}")
+    text = (str(exc).splitlines() or [type(exc).__name__])[0]
+    if isinstance(exc, ArithmeticError) and getattr(args, "effects", "all") not in ("all", "none", None):
+        text += f" (with --effects {args.effects}: strengths far from 1 can make the model unstable)"
+    return text
 
 
 if __name__ == "__main__":  # pragma: no cover
