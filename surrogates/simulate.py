@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -608,6 +608,7 @@ def simulate(
     initial: Mapping[str, float] | None = None,
     waves: object = None,
     wind: object = None,
+    on_progress: Callable[[float], None] | None = None,
 ) -> Record | list[Record]:
     """Simulate the surrogate under a load case and return its 45 sensor channels.
 
@@ -648,6 +649,10 @@ def simulate(
         hub series) instead of the turbulence draw; the case's ``wind_speed`` is the linearisation point (use
         the measured mean). With replayed inputs the simulation starts at the latest start of their time axes
         and the returned record's time stamps are theirs (``transient`` later).
+    on_progress : callable, optional
+        A progress bar's hook: called with the simulated seconds (transient included) just integrated, about
+        every 1 % of each seed's run; ``(duration + transient) * n_seeds`` seconds in all. With several seeds it
+        is called from their threads. The record is the same bit for bit with or without it.
 
     Returns
     -------
@@ -703,8 +708,15 @@ def simulate(
         x, ctrl = x_start.copy(), ctrl_start.copy()
         x_hist = np.zeros((n_rec, N_STATE))
         u_hist = np.zeros((n_rec, N_INPUT - N_EX))
-        sim.advance(x, ctrl, psi0, 0, n_steps, sim.substeps, sim.exogenous(u_ex), u_ex, np.zeros(2), vel, blade,
-                    x_hist, u_hist, 0)
+        exo, action = sim.exogenous(u_ex), np.zeros(2)
+        # in chunks of whole output samples when someone watches (the stepper resumes exactly where it stopped)
+        chunk = n_steps if on_progress is None else sim.substeps * max(1, n_rec // 100)
+        for k0 in range(0, n_steps, chunk):
+            n = min(chunk, n_steps - k0)
+            psi0 = sim.advance(x, ctrl, psi0, k0, n, sim.substeps, exo, u_ex, action, vel, blade, x_hist, u_hist,
+                               k0 // sim.substeps)
+            if on_progress is not None:
+                on_progress(n * sim.dt_int)
         return sim.outputs(x_hist[n_skip:], u_ex[out_steps], u_hist[n_skip:])
 
     # FFT synthesis, the compiled stepper (nogil) and BLAS all release the GIL: a batch runs on threads
