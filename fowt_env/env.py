@@ -228,19 +228,19 @@ class SparEnv(gym.Env):
         return np.where(mask, y, 0.0), mask
 
     def _obs(self, y: np.ndarray, mask: np.ndarray) -> dict[str, np.ndarray]:
-        sensors = np.clip(y, -self.sensor_range, self.sensor_range).astype(np.float64)
+        sensors = np.clip(y, -self.sensor_range, self.sensor_range).astype(np.float64, copy=False)
         return {"sensors": sensors, "mask": mask.astype(np.int8)}
 
-    def _physical_action(self, action) -> np.ndarray:
+    def _physical_action(self, action) -> tuple[np.ndarray, np.ndarray]:
+        """Physical offsets ``[pitch (rad), torque (N·m)]`` and the checked normalised action (float64)."""
         raw = np.asarray(action)
-        shown = " ".join(repr(action).split())  # one line, whatever the action's repr
-        shown = shown if len(shown) <= 80 else shown[:77] + "..."
         if np.iscomplexobj(raw):
-            raise TypeError(f"action must be real [pitch, torque] in [-1, 1], got complex values: {shown}")
+            raise TypeError(f"action must be real [pitch, torque] in [-1, 1], got complex values: {_shown(action)}")
         try:
             a = np.asarray(raw, dtype=float)
         except (TypeError, ValueError):
-            raise TypeError(f"action must be two real numbers [pitch, torque] in [-1, 1], got {shown}") from None
+            raise TypeError(f"action must be two real numbers [pitch, torque] in [-1, 1], got {_shown(action)}"
+                            ) from None
         if a.shape != (2,):
             raise ValueError(f"action must have shape (2,) [pitch, torque], got {a.shape}")
         a0, a1 = float(a[0]), float(a[1])
@@ -347,6 +347,12 @@ MAX_STEP_SAMPLES = 2_000_000
 (a few hundred MB of forcing and output arrays): a ``dt`` of 1e-7 s or a warm-up of 1e7 s is refused up front
 instead of ending in a ``MemoryError`` asking for hundreds of GiB."""
 _CHUNK_SECONDS = 600.0  # surrogates.StreamingSimulator's default forcing chunk
+
+
+def _shown(action: object) -> str:
+    """``repr(action)`` on one line, cut at 80 characters (for error messages only: a repr costs more than a step)."""
+    shown = " ".join(repr(action).split())
+    return shown if len(shown) <= 80 else shown[:77] + "..."
 
 
 def _real(name: str, value: object) -> float:

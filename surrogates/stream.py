@@ -191,6 +191,10 @@ class StreamingSimulator:
             return truth, truth
         e = self._noise_rng.standard_normal((2, n_samples, len(self.channels)))
         # AR(1) coloured part x_i = a x_{i-1} + sqrt(1 - a^2) sigma e_i, its state carried between calls
+        if n_samples == 1:  # the environment's usual step: the same arithmetic as below, fewer temporaries
+            state = self._ar * self._ar_state + self._ar_gain * e[0, 0]
+            self._ar_state = state
+            return truth + self._white * e[1] + state, truth
         if n_samples <= 8:
             colored = np.empty((n_samples, len(self.channels)))
             state = self._ar_state
