@@ -434,9 +434,12 @@ class FOWTModel:
         f_x += np.outer(h_v, t_x) + np.outer(r_s, qg_x)
         f_u += np.outer(h_v, t_u) + np.outer(r_s, qg_u)
         f_u[:, 0] += st.gravity_load + h_v * t0 + r_s * qg0
-        # the mean thrust follows the rotor axis as the tower top pitches (theta about y turns e_s by e_y x e_s):
-        # the platform's set-down and heave-pitch coupling under thrust (the simulation's rotor does the same)
-        f_x[:, :N_DOF] += t0 * np.outer(j_hub.T @ np.cross([0.0, 1.0, 0.0], e_s), r_tt[1])
+        # the mean thrust follows the rotor axis as the tower top pitches and yaws (a rotation theta about axis a
+        # turns e_s by theta e_a x e_s): pitch gives the platform's set-down and heave-pitch coupling under thrust,
+        # yaw a side force T psi that drives sway and roll (the simulation's rotor does the same; roll, which
+        # turns only the shaft's tilt component, is left out there and here)
+        for axis in (1, 2):
+            f_x[:, :N_DOF] += t0 * np.outer(j_hub.T @ np.cross(np.eye(3)[axis], e_s), r_tt[axis])
         f_u[:6, INPUT_BLOCKS["wave"]] += np.eye(6)
         hub = INPUT_BLOCKS["hub"]
         f_u[:, hub.start:hub.start + 3] += j_hub.T
