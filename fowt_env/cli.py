@@ -154,11 +154,16 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     measured = load_record(src, unknown_channels="keep")
     heights = getattr(surrogates, "OPENFAST_GAUGE_HEIGHTS", None)
     model = surrogates.FOWTModel(_parse_effects(args.effects), gauge_heights=heights)
-    t0 = time.perf_counter()
-    rec = replay_record(src, wind=args.wind_file, model=model, transient=args.transient, dt=args.dt,
-                        seed=args.seed)
-    wall = time.perf_counter() - t0
-    path = _save_record(rec, args.out)
+    from .progress import simulation_bar
+
+    with simulation_bar(measured.duration, "replay") as (bar, hook):  # the record's span: transient + output
+        t0 = time.perf_counter()
+        rec = replay_record(src, wind=args.wind_file, model=model, transient=args.transient, dt=args.dt,
+                            seed=args.seed, on_progress=hook)
+        wall = time.perf_counter() - t0
+        bar.update(bar.total - bar.n)  # the last samples' rounding
+        bar.set_postfix_str(f"writing {Path(args.out).name}")
+        path = _save_record(rec, args.out)
     wind = rec.meta.get("replay", {}).get("wind") or {}
     print(f"wrote {path}: replay of {src.name} ({rec.t[0]:.1f}-{rec.t[-1]:.1f} s; wind: "
           f"{wind.get('level', 'none')}), {rec.n_samples} samples x {rec.n_channels} channels in {wall:.2f} s")
@@ -175,10 +180,16 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         return _cmd_replay(args)
     if args.wind_file is not None:
         raise _UsageError("--wind-file needs --replay RECORD")
+    from .progress import simulation_bar
+
     model = surrogates.FOWTModel(_parse_effects(args.effects))
-    rec, wall = _timed_simulation(model, _case(args.case), duration=args.duration, dt=args.dt, seed=args.seed,
-                                  noise=not args.no_noise)
-    path = _save_record(rec, args.out)
+    case = _case(args.case)
+    with simulation_bar(args.duration + 60.0, "simulate") as (bar, hook):  # 60 s: simulate's default transient
+        rec, wall = _timed_simulation(model, case, duration=args.duration, dt=args.dt, seed=args.seed,
+                                      noise=not args.no_noise, on_progress=hook)
+        bar.update(bar.total - bar.n)  # the last samples' rounding
+        bar.set_postfix_str(f"writing {Path(args.out).name}")
+        path = _save_record(rec, args.out)
     print(f"wrote {path}: {rec.n_samples} samples x {rec.n_channels} channels, {rec.duration:.1f} s simulated "
           f"in {wall:.2f} s ({rec.duration / max(wall, 1e-9):.0f}x real time)")
     from .validation import DEL_CHANNELS, record_dels
@@ -551,7 +562,10 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     print(f"\nModal analysis of the model linearised at {case.name} (the modes the PSD marks and the "
           "identification is checked against):")
     print(modes)
-    rec, wall = _timed_simulation(model, case, duration=args.duration, dt=0.0125, seed=args.seed)
+    from .progress import simulation_bar
+
+    with simulation_bar(args.duration + 60.0, "simulate") as (_, hook):
+        rec, wall = _timed_simulation(model, case, duration=args.duration, dt=0.0125, seed=args.seed, on_progress=hook)
     print(f"\nSimulated {rec.duration:.0f} s at 80 Hz in {wall:.2f} s ({rec.duration / max(wall, 1e-9):.0f}x real "
           "time)")
     print(_stats_table(rec, ["PtfmSurge", "PtfmPitch", "PtfmYaw", "RotSpeed", "TwHt1MLyt", "TwHt1MLxt",

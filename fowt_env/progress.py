@@ -23,9 +23,13 @@ from __future__ import annotations
 
 import os
 import sys
+import threading
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import IO, Any
 
-__all__ = ["BAR_FORMAT", "DEFAULT_DELAY_S", "DELAY_ENV", "delay_s", "on_terminal", "progress_bar", "resolve"]
+__all__ = ["BAR_FORMAT", "DEFAULT_DELAY_S", "DELAY_ENV", "delay_s", "on_terminal", "progress_bar", "resolve",
+           "simulation_bar"]
 
 #: Seconds a step runs before its bar appears.
 DEFAULT_DELAY_S: float = 2.0
@@ -125,6 +129,49 @@ def progress_bar(total: float | None, desc: str, *, unit: str = "steps", progres
                         delay=delay_s() if progress is None else 0.0, dynamic_ncols=True,
                         smoothing=0.1, bar_format=BAR_FORMAT if total is not None else None, mininterval=0.2,
                         tick_s=tick_s)
+
+
+@contextmanager
+def simulation_bar(total_s: float, desc: str = "simulate", *, progress: bool | None = None,
+                   stream: IO[str] | None = None) -> Iterator[tuple[Any, Callable[[float], None]]]:
+    """A bar of simulated seconds and the hook that advances it, for ``surrogates.simulate(..., on_progress=hook)``.
+
+    Parameters
+    ----------
+    total_s : float
+        Simulated seconds the run will integrate (duration + transient, times the number of seeds).
+    desc : str
+        What is running.
+    progress : bool or None
+        As :func:`progress_bar`.
+    stream : text stream, optional
+        Default standard error.
+
+    Yields
+    ------
+    bar : tqdm.tqdm
+        The bar (whole seconds; ``set_postfix_str`` names the phase: before the first call of the hook it says
+        ``set-up, waves and wind``).
+    hook : callable
+        ``hook(seconds)``: that many more simulated seconds are done; thread-safe (a batch of seeds calls it from
+        several threads).
+    """
+    total = max(1, int(round(total_s)))
+    lock = threading.Lock()
+    done = [0.0]
+    with progress_bar(total, desc, unit="s simulated", progress=progress, stream=stream) as bar:
+        bar.set_postfix_str("set-up, waves and wind", refresh=False)
+
+        def hook(seconds: float) -> None:
+            with lock:
+                if done[0] == 0.0:
+                    bar.set_postfix_str("time stepping", refresh=False)
+                done[0] += float(seconds)
+                step = min(total, int(done[0] + 1e-6)) - bar.n
+                if step > 0:
+                    bar.update(step)
+
+        yield bar, hook
 
 
 _BAR: type | None = None

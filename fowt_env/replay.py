@@ -30,7 +30,7 @@ from __future__ import annotations
 import json
 import math
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -183,7 +183,8 @@ def _sidecar(path: Path, suffix: str) -> Path | None:
 
 
 def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: Any = None, model: Any = None,
-                  transient: float = 100.0, dt: float = 0.025, initial: bool = True, seed: int = 0) -> Any:
+                  transient: float = 100.0, dt: float = 0.025, initial: bool = True, seed: int = 0,
+                  on_progress: Callable[[float], None] | None = None) -> Any:
     """Simulate the surrogate under a record's measured waves and wind.
 
     Parameters
@@ -206,6 +207,9 @@ def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: A
         Start from the record's first sample (:func:`record_initial`) instead of the static equilibrium.
     seed : int
         Seeds only the rotor's initial azimuth.
+    on_progress : callable, optional
+        Progress hook of :func:`surrogates.simulate` (simulated seconds just integrated; about the record's
+        length in all).
 
     Returns
     -------
@@ -247,7 +251,7 @@ def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: A
         init.pop("RotSpeed", None)
         init.pop("Azimuth", None)
     return surrogates.simulate(model, lc, dt=dt, seed=seed, transient=transient, noise=False, initial=init,
-                               waves=waves_in, wind=wind_in)
+                               waves=waves_in, wind=wind_in, on_progress=on_progress)
 
 
 @dataclass

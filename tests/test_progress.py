@@ -139,3 +139,47 @@ def test_discrepancy_progress_counts_every_simulation_it_runs(capsys, monkeypatc
     # parabola refines the best) + 2 spectra
     assert bar.total in (3 + 1 + 9 + 2, 3 + 1 + 12 + 2)
     assert rep.gap_before >= 0
+
+
+# "simulate:  40%|####      | 72/180 s simulated [00:01 elapsed, ETA 00:01, time stepping]"
+_SIM_BAR = re.compile(r"simulate: +\d+%\|[^|]*\| (\d+)/(\d+) s simulated \[(\d\d:\d\d) elapsed, ETA (\d\d:\d\d|\?)")
+
+
+def _simulate_argv(path) -> list[str]:
+    return [sys.executable, "-m", "fowt_env.cli", "simulate", "--case", "7", "--duration", "120", "--out", str(path)]
+
+
+def test_simulate_on_a_terminal_shows_simulated_seconds_and_an_eta(tmp_path):
+    code, out = _run_on_a_terminal(_simulate_argv(tmp_path / "r.npz"))
+    assert code == 0, out
+    bars = _SIM_BAR.findall(out)
+    assert bars, out
+    assert {total for _, total, _, _ in bars} == {"180"}  # 120 s + the 60 s transient
+    assert any(eta != "?" for *_, eta in bars), bars
+    assert [int(n) for n, *_ in bars] == sorted(int(n) for n, *_ in bars)
+    assert "wrote " in out and (tmp_path / "r.npz").is_file()
+
+
+def test_simulate_piped_has_no_progress(tmp_path):
+    proc = subprocess.run(_simulate_argv(tmp_path / "r.npz"), capture_output=True, text=True, env=_env(), timeout=300,
+                          stdin=subprocess.DEVNULL)
+    assert proc.returncode == 0, proc.stderr
+    assert "wrote " in proc.stdout
+    for stream in (proc.stdout, proc.stderr):
+        assert "ETA" not in stream and "\r" not in stream and "%|" not in stream
+
+
+
+@pytest.mark.slow
+def test_simulate_replay_on_a_terminal_shows_the_records_seconds(tmp_path):
+    from pathlib import Path
+
+    import fowt_env
+
+    src = Path(fowt_env.__file__).parent / "data" / "openfast_reference" / "c_op12_Hs2p5_Tp10.npz"
+    code, out = _run_on_a_terminal([sys.executable, "-m", "fowt_env.cli", "simulate", "--replay", str(src),
+                                    "--out", str(tmp_path / "replay.npz")])
+    assert code == 0, out
+    bars = re.findall(r"replay: +\d+%\|[^|]*\| (\d+)/(\d+) s simulated \[\d\d:\d\d elapsed, ETA (\d\d:\d\d|\?)", out)
+    assert bars and {total for _, total, _ in bars} == {"600"}, out  # the record's 600 s
+    assert any(n == total for n, total, _ in bars) and any(eta != "?" for *_, eta in bars)
