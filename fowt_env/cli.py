@@ -660,7 +660,11 @@ def _compare_request(args: argparse.Namespace) -> tuple[list[str], list[str], di
     settings = CompareSettings(
         train_cases=tuple(parse_int_list(args.train_cases, "--train-cases")), train_duration=args.train_duration,
         train_seed=args.train_seed, duration=args.duration, plane=None if args.plane == "all" else args.plane,
-        dropout_rate=args.dropout_rate, dropout_burst_s=args.dropout_burst, estimator_options=options)
+        dropout_rate=args.dropout_rate, dropout_burst_s=args.dropout_burst, estimator_options=options,
+        train_files=tuple(args.train or ()), test_files=tuple(args.test or ()),
+        band=tuple(floats(args.band, "band")),  # type: ignore[arg-type]
+        truth_effects={k: _option_value(v) for k, _, v in (item.strip().partition("=") for item in
+                                                          (args.truth_model or "").split(",") if item.strip())})
     return scenarios, [e.strip() for e in args.estimators.split(",")], {
         "cases": parse_int_list(args.cases, "--cases") if args.cases else None,
         "seeds": parse_int_list(args.seeds, "--seeds"), "update_intervals": intervals, "settings": settings,
@@ -858,6 +862,17 @@ def build_parser() -> argparse.ArgumentParser:
                    help="seconds, 'auto' (Rosenstein on band-passed tower-top acceleration) or 'none'")
     c.add_argument("--option", action="append", metavar="EST.PARAM=VALUE",
                    help="repeatable estimator option (VALUE parsed as JSON if it can be), e.g. dmd.rank=24")
+    c.add_argument("--train", nargs="+", default=None, metavar="FILE",
+                   help="train on these records (OpenFAST .out/.outb, .csv, .parquet, .npz) instead of simulated OLCs; "
+                        "with --test (then --cases are test-file indices; kalman is linearised at each test record's "
+                        "operating point: its .case.json sidecar, metadata or mean Wind1VelX)")
+    c.add_argument("--test", nargs="+", default=None, metavar="FILE", help="test on these records (with --train)")
+    c.add_argument("--band", default="0.25,5", metavar="LO,HI",
+                   help="band (Hz) of the band-passed scores, below the records' Nyquist frequency (default 0.25,5)")
+    c.add_argument("--truth-model", default=None, metavar="NAME=VALUE,...",
+                   help="simulated records from a perturbed truth model, e.g. tower_stiffness=0.95, "
+                        "platform_mass=1.03, quadratic_drag=1.5, mooring_stiffness=0.7, rotor_mass_imbalance=0.02; "
+                        "kalman keeps the nominal model")
     c.add_argument("--json", default=None, help="write the result as JSON (reproducible; --timings adds timings)")
     c.add_argument("--timings", action="store_true",
                    help="include the wall-clock timings in the JSON (machine-dependent; without them the JSON is "

@@ -108,24 +108,44 @@ _hold.uses_update_interval = False  # type: ignore[attr-defined]
 
 
 def _kalman(dt: float, update_interval: float | None, *, channels: Sequence[str] | None = None,
-            linearization_case: int = _KALMAN_LINEARIZATION_CASE, **options: Any) -> Any:
+            linearization_case: Any = _KALMAN_LINEARIZATION_CASE, gauge_heights: Sequence[float] | None = None,
+            model_perturbation: dict[str, float] | None = None, **options: Any) -> Any:
     """:class:`estimators.kalman.KalmanSensor` on ``FOWTModel().linearize(load_case(7))``, rows = the channels.
 
-    Assimilates every sample, so ``update_interval`` is ignored. ``options`` go to ``KalmanSensor``.
+    Assimilates every sample, so ``update_interval`` is ignored. ``linearization_case`` is an OLC number, a
+    :class:`surrogates.LoadCase` or its ``to_dict()`` (with records from files, :func:`compare` passes the test
+    record's operating point); ``gauge_heights`` (9 heights above SWL, m) places the model's gauges where the
+    records' are (e.g. :data:`surrogates.OPENFAST_GAUGE_HEIGHTS` for the shared OpenFAST runs);
+    ``model_perturbation`` makes the filter's model a :func:`surrogates.model_error.perturbed_model` (e.g. the
+    true model of a ``truth_effects`` study). Other ``options`` go to ``KalmanSensor``.
     """
     import control
 
     import surrogates
     from estimators.kalman import KalmanSensor
     from surrogates.channels import tower_channels
+    from surrogates.model_error import perturbed_model
 
-    model = surrogates.FOWTModel()
-    case = surrogates.load_case(int(linearization_case))
+    if isinstance(linearization_case, dict):
+        case = surrogates.LoadCase.from_dict(linearization_case)
+    elif isinstance(linearization_case, surrogates.LoadCase):
+        case = linearization_case
+    else:
+        case = surrogates.load_case(int(linearization_case))
     names = list(channels) if channels is not None else tower_channels("FA")
+
+    def linearize(plane: str | None) -> Any:
+        def compute() -> Any:
+            model = perturbed_model(model_perturbation, surrogates.FOWTModel(gauge_heights=gauge_heights))
+            return _without_inert_states(model.linearize(case, plane=plane))
+
+        key = json.dumps([case.to_dict(), plane, gauge_heights, model_perturbation], sort_keys=True, default=str)
+        return _LINEARIZED.get(key, compute)
+
     for plane in ("FA", "SS"):
         if names == tower_channels(plane):
-            return KalmanSensor(model.linearize(case, plane=plane), dt=dt, **options)
-    full = model.linearize(case)  # all channels: keep the rows of the observed ones
+            return KalmanSensor(linearize(plane), dt=dt, **options)
+    full = linearize(None)  # all channels: keep the rows of the observed ones
     outputs = list(full.output_labels)
     missing = [c for c in names if c not in outputs]
     if missing:
@@ -136,7 +156,23 @@ def _kalman(dt: float, update_interval: float | None, *, channels: Sequence[str]
     return KalmanSensor(sys, dt=dt, **options)
 
 
+def _without_inert_states(sys: Any) -> Any:
+    """``sys`` without the states that act on nothing (zero columns of A and C), e.g. the pitch controller's
+    integrator below rated wind, a pure integrator (eigenvalue 0) a Kalman filter's stationary analysis refuses.
+    Exact: such a state changes no other state and no output."""
+    import control
+
+    a, c = np.asarray(sys.A), np.asarray(sys.C)
+    keep = [i for i in range(a.shape[0]) if np.any(a[:, i]) or np.any(c[:, i])]
+    if len(keep) == a.shape[0]:
+        return sys
+    labels = list(sys.state_labels)
+    return control.ss(a[np.ix_(keep, keep)], np.asarray(sys.B)[keep], c[:, keep], sys.D, inputs=list(sys.input_labels),
+                      outputs=list(sys.output_labels), states=[labels[i] for i in keep])
+
+
 _kalman.uses_update_interval = False  # type: ignore[attr-defined]
+_kalman.needs_operating_point = True  # type: ignore[attr-defined]  # records from files: at each test record's
 
 
 def _dmd(dt: float, update_interval: float | None, *, channels: Sequence[str] | None = None,
@@ -253,6 +289,19 @@ class CompareSettings:
         Per-estimator keyword options for the factories, e.g. ``{"dmd": {"rank": 24}}``.
     trace_seconds : float
         Length (s) of the end of each test record kept in memory for :meth:`CompareResult.plot` (0: none).
+    train_files, test_files : tuple of str
+        Records from files instead of simulations (both or neither): anything :func:`fowt_env.io.load_record`
+        reads (OpenFAST ``.out``/``.outb``, ``.csv``/``.parquet``, ``.npz``). The sensors see the plane's tower
+        channels present in every one of them; the test OLCs of the grid become indices into ``test_files``,
+        the seeds only seed the ``"random"`` masks, and the scores compare with the record itself (it is the
+        truth: no noise-free copy exists). ``dt`` is replaced by the records' sample time (they must share one),
+        ``train_cases``/``train_seed``/``duration`` are unused. Model-based sensors (``kalman``) are linearised at
+        each test record's operating point: its ``<name>.case.json`` sidecar, else its metadata's ``case``, else
+        the mean of ``Wind1VelX`` (and 4 std / the spectral peak of ``Wave1Elev``).
+    truth_effects : dict
+        Surrogate records only: the training and test records come from
+        :func:`surrogates.model_error.perturbed_model` with these perturbations (e.g. ``{"tower_stiffness":
+        0.95}``) while ``kalman`` keeps the nominal model -- the model-error axis. Empty: the nominal model.
     """
 
     train_cases: tuple[int, ...] = PAPER_TRAIN_CASES
@@ -266,9 +315,25 @@ class CompareSettings:
     dropout_burst_s: float = 2.0
     estimator_options: dict[str, dict[str, Any]] = field(default_factory=dict)
     trace_seconds: float = 20.0
+    train_files: tuple[str, ...] = ()
+    test_files: tuple[str, ...] = ()
+    truth_effects: dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         import surrogates
+        from surrogates.model_error import check_perturbations
+
+        for name in ("train_files", "test_files"):
+            files = getattr(self, name)
+            files = (files,) if isinstance(files, (str, Path)) else tuple(files or ())
+            object.__setattr__(self, name, tuple(str(f) for f in files))
+        if bool(self.train_files) != bool(self.test_files):
+            raise ValueError("train_files and test_files must be given together (records from files), or neither")
+        object.__setattr__(self, "truth_effects", check_perturbations(self.truth_effects))
+        if self.files and self.truth_effects:
+            raise ValueError("truth_effects perturbs simulated records; records from files are their own truth")
+        if self.files:
+            self._init_files()
 
         cases = tuple(int(c) for c in np.atleast_1d(self.train_cases))
         if not cases:
@@ -305,12 +370,45 @@ class CompareSettings:
         if round(self.duration / self.dt) < 10:
             raise ValueError(f"duration={self.duration} s is shorter than 10 samples")
 
+    def _init_files(self) -> None:
+        """Read the records (memoised), take their common sample time and channels; check the test records."""
+        from surrogates.channels import ALL_CHANNELS, tower_channels
+
+        wanted = tower_channels(self.plane) if self.plane is not None else list(ALL_CHANNELS[:36])
+        recs = [_file_record(f) for f in self.train_files + self.test_files]
+        dts = sorted({r.dt for r in recs})
+        if dts[-1] - dts[0] > 1e-9 * dts[0]:
+            listing = ", ".join(f"{r.name}: {r.dt:g} s" for r in recs)
+            raise ValueError(f"the records must share one sample time; got {listing}")
+        object.__setattr__(self, "dt", dts[0])
+        common = [c for c in wanted if all(c in r.channels for r in recs)]
+        if not common:
+            raise ValueError(f"the records have no {self.plane or 'tower'} channel in common (looked for "
+                             f"{wanted[0]} ... {wanted[-1]})")
+        object.__setattr__(self, "_file_channels", common)
+        train = {str(Path(f).resolve()) for f in self.train_files}
+        both = [f for f in self.test_files if str(Path(f).resolve()) in train]
+        if both:
+            raise ValueError(f"test file(s) {both} are also training files: test on records the sensors did not "
+                             f"see")
+
+    @property
+    def files(self) -> bool:
+        """True if the records come from files (:attr:`train_files`, :attr:`test_files`)."""
+        return bool(self.test_files)
+
     @property
     def channels(self) -> list[str]:
         """Names of the channels the sensors see, in order."""
         from surrogates.channels import ALL_CHANNELS, tower_channels
 
+        if self.files:
+            return list(self.__dict__["_file_channels"])
         return tower_channels(self.plane) if self.plane is not None else list(ALL_CHANNELS[:36])
+
+    def test_name(self, case: int) -> str:
+        """Label of test record ``case``: its file name (records from files) or ``OLC <case>``."""
+        return Path(self.test_files[int(case)]).name if self.files else f"OLC {int(case)}"
 
     def train_seed_of(self, case: int) -> int:
         """Seed of the training record of OLC ``case``."""
@@ -321,6 +419,7 @@ class CompareSettings:
         d = asdict(self)
         d["train_cases"] = list(self.train_cases)
         d["band"] = list(self.band)
+        d["train_files"], d["test_files"] = list(self.train_files), list(self.test_files)
         d["channels"] = self.channels
         return d
 
@@ -396,20 +495,114 @@ class _OneBlasThread(ContextDecorator):
 _one_blas_thread = _OneBlasThread()
 
 _TRAIN_DATA = _Memo(2)
+_LINEARIZED = _Memo(8)
 _TEST_DATA = _Memo(8)
 _SENSORS = _Memo(16)
 
 
 def clear_cache() -> None:
     """Forget the memoised simulations and fitted sensors of this process."""
-    for memo in (_TRAIN_DATA, _TEST_DATA, _SENSORS):
+    for memo in (_TRAIN_DATA, _TEST_DATA, _SENSORS, _LINEARIZED, _FILES):
         memo.clear()
 
 
-def _model():
+def _model(settings: CompareSettings | None = None):
+    """The model that makes the records: nominal, or perturbed by ``settings.truth_effects``."""
+    import surrogates
+    from surrogates.model_error import perturbed_model
+
+    return perturbed_model(settings.truth_effects if settings is not None else None, surrogates.FOWTModel())
+
+
+# ------------------------------------------------------------------------------------------------ files
+@dataclass(frozen=True)
+class _FileRecord:
+    """The part of a record file the harness uses: tower channels, sample time, operating point."""
+
+    name: str
+    dt: float
+    channels: tuple[str, ...]
+    y: np.ndarray  # (n_samples, n_channels), the tower channels present
+    operating: dict[str, Any] | None  # LoadCase.to_dict() of the operating point, or None
+    operating_source: str
+
+
+_FILES = _Memo(16)
+_OPERATING_KEYS = ("wind_speed", "hs", "tp", "gamma", "wave_dir_deg", "turbulence_intensity")
+
+
+def _file_record(path: str) -> _FileRecord:
+    """Read a record file once per process (keyed by path, size and modification time)."""
+    p = Path(path)
+    try:
+        st = p.stat()
+        key = json.dumps([str(p.resolve()), st.st_size, st.st_mtime_ns])
+    except OSError:
+        key = json.dumps([str(p), None, None])  # load_record says what is wrong
+    return _FILES.get(key, lambda: _read_file_record(p))
+
+
+def _read_file_record(p: Path) -> _FileRecord:
+    from surrogates.channels import ALL_CHANNELS
+
+    from .io import load_record
+
+    rec = load_record(p, unknown_channels="keep") if p.suffix.lower() in (".csv", ".parquet") else load_record(p)
+    if rec.y.shape[0] < 10:
+        raise ValueError(f"{p}: a record of {rec.y.shape[0]} samples is too short to test on")
+    tower = [c for c in ALL_CHANNELS[:36] if c in rec.channels]
+    y = np.ascontiguousarray(rec.select(tower).y, dtype=float) if tower else np.zeros((rec.y.shape[0], 0))
+    dt = float(f"{float(rec.dt):.9g}")  # 0.0999999999999 (a float time axis) -> 0.1
+    operating, source = _operating_point(p, rec)
+    return _FileRecord(p.name, dt, tuple(tower), y, operating, source)
+
+
+def _operating_point(p: Path, rec: Any) -> tuple[dict[str, Any] | None, str]:
+    """Operating point of a record: sidecar ``<stem>.case.json``, else ``meta["case"]``, else the channels."""
     import surrogates
 
-    return surrogates.FOWTModel()
+    def from_mapping(d: dict[str, Any]) -> dict[str, Any] | None:
+        if not isinstance(d, dict) or not isinstance(d.get("wind_speed"), (int, float)) or d["wind_speed"] <= 0:
+            return None
+        kw = {k: float(d[k]) for k in _OPERATING_KEYS[1:] if isinstance(d.get(k), (int, float))}
+        lc = surrogates.operating_case(float(d["wind_speed"]), **kw)
+        if isinstance(d.get("rotor_rpm"), (int, float)) and d["rotor_rpm"] > 0:
+            lc = lc.replace(rotor_rpm=float(d["rotor_rpm"]))
+        return lc.to_dict()
+
+    stem = p.name[: -len(p.suffix)] if p.suffix else p.name
+    sidecar = p.with_name(stem + ".case.json")
+    if sidecar.is_file():
+        try:
+            found = from_mapping(json.loads(sidecar.read_text(encoding="utf-8")))
+        except (OSError, ValueError):
+            found = None
+        if found is not None:
+            return found, f"sidecar {sidecar.name}"
+    meta_case = (rec.meta or {}).get("case") if isinstance(getattr(rec, "meta", None), dict) else None
+    if isinstance(meta_case, dict):
+        found = from_mapping(meta_case)
+        if found is not None:
+            return found, "record metadata"
+    if "Wind1VelX" in rec.channels:
+        u = np.asarray(rec["Wind1VelX"], dtype=float)
+        u = u[np.isfinite(u)]
+        if u.size and float(np.mean(u)) > 0:
+            d: dict[str, Any] = {"wind_speed": float(np.mean(u)), "turbulence_intensity": float(np.std(u) /
+                                                                                                np.mean(u))}
+            source = "mean of Wind1VelX"
+            if "Wave1Elev" in rec.channels:
+                from scipy.signal import welch
+
+                eta = np.asarray(rec["Wave1Elev"], dtype=float)
+                eta = eta[np.isfinite(eta)]
+                if eta.size > 64 and np.std(eta) > 0:
+                    f, pxx = welch(eta - eta.mean(), fs=1.0 / float(rec.dt), nperseg=min(eta.size, 8192))
+                    band = (f > 0.03) & (f < 0.5)
+                    d.update(hs=4.0 * float(np.std(eta)), tp=1.0 / float(f[band][np.argmax(pxx[band])]))
+                    source += ", Hs and Tp from Wave1Elev"
+            return from_mapping(d), source
+    return None, "none (no case.json sidecar, no metadata, no Wind1VelX)"
 
 
 def _select(record, settings: CompareSettings) -> np.ndarray:
@@ -421,13 +614,21 @@ def training_data(settings: CompareSettings) -> list[np.ndarray]:
     import surrogates
 
     def compute() -> list[np.ndarray]:
-        model = _model()
+        if settings.files:
+            return [_file_columns(f, settings) for f in settings.train_files]
+        model = _model(settings)
         return [_select(surrogates.simulate(model, c, duration=settings.train_duration, dt=settings.dt,
                                             seed=settings.train_seed_of(c)), settings)
                 for c in settings.train_cases]
 
-    key = settings._key("train_cases", "train_duration", "train_seed", "dt", "plane")
+    key = settings._key("train_cases", "train_duration", "train_seed", "dt", "plane", "train_files",
+                        "truth_effects")
     return [a.copy() for a in _TRAIN_DATA.get(key, compute)]
+
+
+def _file_columns(path: str, settings: CompareSettings) -> np.ndarray:
+    rec = _file_record(path)
+    return np.ascontiguousarray(rec.y[:, [rec.channels.index(c) for c in settings.channels]])
 
 
 def held_out_data(case: int, seed: int, settings: CompareSettings) -> tuple[np.ndarray, np.ndarray]:
@@ -435,18 +636,38 @@ def held_out_data(case: int, seed: int, settings: CompareSettings) -> tuple[np.n
     import surrogates
 
     def compute() -> tuple[np.ndarray, np.ndarray]:
-        noisy, truth = surrogates.simulate(_model(), int(case), duration=settings.duration, dt=settings.dt,
+        if settings.files:  # the record is the truth; there is no noise-free copy of a measurement
+            y = _file_columns(settings.test_files[int(case)], settings)
+            return y, y
+        noisy, truth = surrogates.simulate(_model(settings), int(case), duration=settings.duration, dt=settings.dt,
                                            seed=int(seed), return_truth=True)
         return _select(noisy, settings), _select(truth, settings)
 
-    key = json.dumps([int(case), int(seed), settings._key("duration", "dt", "plane")])
+    key = json.dumps([int(case), 0 if settings.files else int(seed),
+                      settings._key("duration", "dt", "plane", "test_files", "truth_effects")])
     noisy, truth = _TEST_DATA.get(key, compute)
     return noisy.copy(), truth.copy()
 
 
-def _new_sensor(estimator: str, update_interval: float | None, settings: CompareSettings) -> Any:
+def _operating_options(estimator: str, settings: CompareSettings, case: int | None) -> dict[str, Any]:
+    """Records from files: ``{"linearization_case": <the test record's operating point>}`` for the sensors that
+    need one (factory attribute ``needs_operating_point``), unless the user's options fix it; else ``{}``."""
     factory = _factory(estimator)
-    opts = settings.estimator_options.get(estimator, {})
+    if not (settings.files and getattr(factory, "needs_operating_point", False)):
+        return {}
+    if "linearization_case" in settings.estimator_options.get(estimator, {}):
+        return {}
+    rec = _file_record(settings.test_files[0 if case is None else int(case)])
+    if rec.operating is None:
+        raise ValueError(f"estimator {estimator!r} needs the operating point of test record {rec.name}: "
+                         f"{rec.operating_source}; give it, e.g. {estimator}.linearization_case=7 (an OLC)")
+    return {"linearization_case": rec.operating}
+
+
+def _new_sensor(estimator: str, update_interval: float | None, settings: CompareSettings,
+                extra: dict[str, Any] | None = None) -> Any:
+    factory = _factory(estimator)
+    opts = {**settings.estimator_options.get(estimator, {}), **(extra or {})}
     try:
         return factory(settings.dt, update_interval, channels=settings.channels, **opts)
     except ImportError as exc:
@@ -455,14 +676,19 @@ def _new_sensor(estimator: str, update_interval: float | None, settings: Compare
         raise ValueError(f"estimator {estimator!r}: bad options {opts}: {exc}") from None
 
 
-def _fitted(estimator: str, update_interval: float | None, settings: CompareSettings) -> tuple[Any, float]:
-    """A deep copy of the memoised fitted sensor, and the wall-clock seconds its fit took."""
+def _fitted(estimator: str, update_interval: float | None, settings: CompareSettings,
+            case: int | None = None) -> tuple[Any, float]:
+    """A deep copy of the memoised fitted sensor, and the wall-clock seconds its fit took.
+
+    ``case`` (records from files): the test record, whose operating point model-based sensors are linearised at.
+    """
     interval = update_interval if _uses_interval(estimator) else None
     refit = getattr(_factory(estimator), "refit_per_interval", True)
     fit_interval = interval if refit or interval is None else 1.0
+    extra = _operating_options(estimator, settings, case)
 
     def compute() -> tuple[Any, float]:
-        sensor = _new_sensor(estimator, fit_interval, settings)
+        sensor = _new_sensor(estimator, fit_interval, settings, extra)
         data = training_data(settings)
         if getattr(_factory(estimator), "concatenate_training", False):
             data = np.concatenate(data, axis=0)
@@ -470,8 +696,9 @@ def _fitted(estimator: str, update_interval: float | None, settings: CompareSett
         sensor.fit(data)
         return sensor, time.perf_counter() - t0
 
-    key = json.dumps([estimator, fit_interval, settings._key("train_cases", "train_duration", "train_seed", "dt",
-                                                             "plane", "estimator_options")], default=str)
+    key = json.dumps([estimator, fit_interval, extra,
+                      settings._key("train_cases", "train_duration", "train_seed", "dt", "plane", "estimator_options",
+                                    "train_files", "truth_effects")], default=str)
     sensor, fit_s = _SENSORS.get(key, compute)
     sensor = copy.deepcopy(sensor)
     if fit_interval != interval:
@@ -513,7 +740,8 @@ def hidden_channels(scenario: str, settings: CompareSettings) -> list[str]:
     if scenario not in SCENARIOS:
         raise ValueError(f"unknown scenario {scenario!r}; choose from {', '.join(SCENARIO_NAMES)}")
     planar = tower_channels(settings.plane or "FA")
-    return [planar[i] for i in SCENARIOS[scenario]["hidden"]]
+    present = set(settings.channels)
+    return [planar[i] for i in SCENARIOS[scenario]["hidden"] if planar[i] in present]
 
 
 def scenario_mask(scenario: str, n_samples: int, settings: CompareSettings, *, seed: int = 0,
@@ -698,7 +926,7 @@ def run_unit(case: int, seed: int, scenario: str, estimator: str, update_interva
     if scenario not in SCENARIO_NAMES:
         raise ValueError(f"unknown scenario {scenario!r}; choose from {', '.join(SCENARIO_NAMES)}")
     interval = _check_interval(update_interval) if _uses_interval(estimator) else None
-    sensor, fit_s = _fitted(estimator, interval, settings)
+    sensor, fit_s = _fitted(estimator, interval, settings, case if settings.files else None)
     noisy, truth = held_out_data(case, seed, settings)
     mask = scenario_mask(scenario, noisy.shape[0], settings, seed=seed, case=case)
     measured = np.where(mask, noisy, np.nan)
@@ -717,10 +945,15 @@ def run_unit(case: int, seed: int, scenario: str, estimator: str, update_interva
     rows = _channel_scores(truth, est, std, hidden, settings)
     out: dict[str, Any] = {
         "scenario": scenario, "case": int(case), "seed": int(seed), "estimator": estimator,
-        "update_interval": interval, "case_in_training": int(case) in settings.train_cases,
+        "update_interval": interval, "case_in_training": not settings.files and int(case) in settings.train_cases,
+        "record": settings.test_name(case),
         "hidden": [r["channel"] for r in rows], "n_samples": int(truth.shape[0]),
         "lost_fraction": float(hidden.mean()), "channels": rows, **_aggregate(rows),
     }
+    if settings.files:
+        rec = _file_record(settings.test_files[int(case)])
+        out["operating_point"] = {"wind_speed": (rec.operating or {}).get("wind_speed"),
+                                  "source": rec.operating_source}
     out["trace"] = _trace(truth, est, hidden, rows, settings)
     out["wall_clock"] = {"fit_s": fit_s, "reconstruct_s": wall, "us_per_sample": 1e6 * wall / truth.shape[0]}
     return out
@@ -762,6 +995,10 @@ def lyapunov_estimate(settings: CompareSettings) -> dict[str, Any]:
 
     case = settings.train_cases[0]
     channel = "TwHt9ALyt" if settings.plane == "SS" else "TwHt9ALxt"
+    what = Path(settings.train_files[0]).name if settings.files else f"the OLC {case}"
+    if channel not in settings.channels:
+        return {"time_s": None, "exponent_per_s": None, "channel": channel, "case": case,
+                "source": f"not computed: the records have no {channel}", "diagnostic": ""}
     y = training_data(settings)[0][:, settings.channels.index(channel)]
     x = sosfiltfilt(band_sos(1.0 / settings.dt, settings.band), y)
     with warnings.catch_warnings(record=True) as caught:
@@ -769,7 +1006,7 @@ def lyapunov_estimate(settings: CompareSettings) -> dict[str, Any]:
         res = lyapunov_exponent(x, settings.dt, return_details=True)
     notes = [str(w.message) for w in caught]
     return {"time_s": _num(res.lyapunov_time), "exponent_per_s": _num(res.exponent), "channel": channel,
-            "case": case, "source": f"computed: Rosenstein on band-passed {channel} of the OLC {case} training record",
+            "case": case, "source": f"computed: Rosenstein on band-passed {channel} of {what} training record",
             "diagnostic": "; ".join(notes + ([res.diagnostic] if res.diagnostic else []))}
 
 
@@ -924,10 +1161,25 @@ class CompareResult:
         furthest from 0.95) and microseconds per sample."""
         s = self.settings
         plane = f"{s.plane} plane ({len(s.channels)} channels)" if s.plane else f"all {len(s.channels)} tower channels"
-        lines = [f"Virtual sensing: trained on OLC {_ranges(s.train_cases)} ({s.train_duration:g} s each), tested on "
-                 f"{s.duration:g} s records, {plane}; R2/NRMSE on the hidden channels (physical; band = "
-                 f"{s.band[0]:g}-{s.band[1]:g} Hz band-passed)"]
-        head = (f"{'scenario':<9}{'OLC':<7}{'hidden':>7}  {'estimator':<10}{'T_up s':>7}{'R2 med':>9}{'R2 worst':>10}"
+        if s.files:
+            train = ", ".join(Path(f).name for f in s.train_files)
+            lines = [f"Virtual sensing on records from files: trained on {train}; {plane} at {1 / s.dt:g} Hz; "
+                     f"R2/NRMSE on the hidden channels (physical; band = "
+                     f"{s.band[0]:g}-{s.band[1]:g} Hz band-passed); the test records are their own truth"]
+            for i, f in enumerate(s.test_files):
+                rec = _file_record(f)
+                op = rec.operating
+                where = f"{op['wind_speed']:.2f} m/s from the {rec.operating_source}" if op else rec.operating_source
+                lines.append(f"  test {i} = {Path(f).name} (operating point: {where})")
+        else:
+            lines = [f"Virtual sensing: trained on OLC {_ranges(s.train_cases)} ({s.train_duration:g} s each), tested "
+                     f"on {s.duration:g} s records, {plane}; R2/NRMSE on the hidden channels (physical; band = "
+                     f"{s.band[0]:g}-{s.band[1]:g} Hz band-passed)"]
+            if s.truth_effects:
+                lines.append(f"  records from a perturbed truth model {s.truth_effects}; kalman keeps the nominal "
+                             f"model unless its model_perturbation option says otherwise")
+        col = "test" if s.files else "OLC"
+        head = (f"{'scenario':<9}{col:<7}{'hidden':>7}  {'estimator':<10}{'T_up s':>7}{'R2 med':>9}{'R2 worst':>10}"
                 f"{'NRMSE%':>8}{'R2 band':>9}{'cov95':>7}{'cov95 ch':>9}{'us/smp':>9}")
         lines += [head, "-" * len(head)]
         speed = self._speed()
@@ -1249,9 +1501,23 @@ def grid_units(
     if not intervals:
         raise ValueError("update_intervals must hold at least one interval")
     for est in estimators:  # unknown or unavailable (not importable) estimators fail here, before any work
-        _new_sensor(est, intervals[0] if _uses_interval(est) else None, settings)
+        _new_sensor(est, intervals[0] if _uses_interval(est) else None, settings,
+                    _operating_options(est, settings, None))
     case_list = None if cases is None else [int(c) for c in cases]
-    for c in case_list or []:
+    if settings.files:  # the test "cases" are the test records
+        n_test = len(settings.test_files)
+        case_list = list(range(n_test)) if case_list is None else case_list
+        bad = [c for c in case_list if not 0 <= c < n_test]
+        if bad:
+            raise ValueError(f"cases: with records from files a case is a test file's index, 0 to {n_test - 1}; "
+                             f"got {bad}")
+        for est in estimators:  # every test record must have an operating point for model-based sensors
+            for c in case_list:
+                _operating_options(est, settings, c)
+        for sc in scenarios:
+            if sc != "random" and not hidden_channels(sc, settings):
+                raise ValueError(f"scenario {sc}: the records have none of the channels it hides")
+    for c in (case_list or []) if not settings.files else []:
         try:
             surrogates.load_case(c)
         except ValueError as exc:
@@ -1263,7 +1529,7 @@ def grid_units(
     for sc in scenarios:
         for case in (case_list if case_list is not None else [DEFAULT_TEST_CASES[sc]]):
             for seed in seed_list:
-                if case in settings.train_cases and seed == settings.train_seed_of(case):
+                if not settings.files and case in settings.train_cases and seed == settings.train_seed_of(case):
                     raise ValueError(f"test OLC {case} with seed {seed} is the training record of that OLC; "
                                      f"use another seed or train_seed")
                 for est in estimators:
