@@ -87,13 +87,18 @@ class DragStrips:
         ndarray (n_t, 6)
             Generalised forces (N, N·m).
         """
-        f = np.einsum("sij,tsj->tsi", self.strip_matrices(), velocity)
-        out = np.zeros((velocity.shape[0], 6))
-        out[:, 0] = f[:, :, 0].sum(axis=1)
-        out[:, 1] = f[:, :, 1].sum(axis=1)
-        out[:, 3] = -(f[:, :, 1] * self.z).sum(axis=1)
-        out[:, 4] = (f[:, :, 0] * self.z).sum(axis=1)
-        return out
+        v = np.asarray(velocity, dtype=float)
+        if v.ndim != 3 or v.shape[1:] != (self.z.size, 2):
+            raise ValueError(f"velocity must have shape (n_t, {self.z.size}, 2), got {v.shape}")
+        # one matrix product: strip s's force D_s v_s acts at height z_s on surge/sway and, as -z F_y and
+        # z F_x, on roll and pitch
+        d = self.strip_matrices()  # (n, 2, 2): d[s, i, j] = force i per velocity j
+        gain = np.zeros((self.z.size, 2, 6))
+        gain[:, :, 0] = d[:, 0, :]
+        gain[:, :, 1] = d[:, 1, :]
+        gain[:, :, 3] = -self.z[:, None] * d[:, 1, :]
+        gain[:, :, 4] = self.z[:, None] * d[:, 0, :]
+        return v.reshape(v.shape[0], -1) @ gain.reshape(-1, 6)
 
 
 def wave_velocity_rao(z: np.ndarray, f_hz: np.ndarray, depth: float = WATER_DEPTH) -> np.ndarray:

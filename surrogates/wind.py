@@ -393,6 +393,47 @@ def synthesize_wind(
 
 _COHERENCE_FLOOR = 1e-4  # above the frequency where all pairs' coherence is below this, points are independent
 _CHOLESKY_CHUNK = 512  # frequencies factored per batch (memory: chunk * n_points^2 * 8 bytes)
+_FFT_BLOCK_VALUES = 1 << 21  # points per batched inverse FFT: at most this many samples (16 MB of float64)
+
+
+def _coherent_coefficients(rng: np.random.Generator, f_hz: np.ndarray, amp: np.ndarray, dist: np.ndarray,
+                           mean_speed: float, coherence_scale: float) -> np.ndarray:
+    """Fourier coefficients of the grid points in the coherent band (Veers): ``amp L(f) z(f)`` per frequency.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Draws the unit-amplitude random phases ``z``, shape ``(n_points, n_freq)``, first of all.
+    f_hz : ndarray (n_freq,)
+        Frequencies (Hz).
+    amp : ndarray (n_freq,)
+        Point amplitudes (the spectrum's, scaled for the inverse FFT).
+    dist : ndarray (n_points, n_points)
+        Distances between the points (m).
+    mean_speed, coherence_scale : float
+        V (m/s) and ``L_c`` (m) of the IEC coherence.
+
+    Returns
+    -------
+    ndarray (n_points, n_freq), complex
+        ``L`` is the Cholesky factor of the coherence matrix ``exp(-a(f) dist)``, so the coefficients have the
+        cross-spectral matrix ``amp^2 Coh``.
+    """
+    n_points, n_freq = dist.shape[0], f_hz.size
+    phase = rng.uniform(0.0, 2.0 * np.pi, (n_points, n_freq))
+    z = np.empty((n_freq, n_points, 2))  # frequency-major, [cos, sin] of the phases
+    z[:, :, 0] = np.cos(phase).T
+    z[:, :, 1] = np.sin(phase).T
+    del phase
+    coef = np.empty((n_points, n_freq), dtype=complex)
+    for start in range(0, n_freq, _CHOLESKY_CHUNK):
+        sl = slice(start, min(start + _CHOLESKY_CHUNK, n_freq))
+        decay = 12.0 * np.sqrt((f_hz[sl] / mean_speed) ** 2 + (0.12 / coherence_scale) ** 2)
+        coh = np.exp(-decay[:, None, None] * dist[None, :, :])
+        chol = np.linalg.cholesky(coh)  # exponential kernel: positive definite for distinct points
+        lz = chol @ z[sl]  # (f, j, 2): L applied to the cos and sin parts of z
+        coef[:, sl] = (lz[:, :, 0] + 1j * lz[:, :, 1]).T * amp[sl]
+    return coef
 
 
 def _polar_weights(radii: np.ndarray, n_azimuth: int, radius: float) -> np.ndarray:
@@ -646,42 +687,40 @@ def synthesize_rotor_wind(
         "n_fft": int(n_fft), "n_points": int(n_points), "coherent_max_hz": float(f_coherent),
     }
     polar = np.empty((n_out, n_radii, n_azimuth), dtype=np.float32) if return_field else None
-    reduced = np.zeros((3, n_out))
-    hub = np.full(n_out, u_mean[0])
+    if not (v > 0.0 and ti > 0.0):  # the steady sheared wind
+        series = np.broadcast_to(u_mean[:, None], (n_points, n_out))
+        if polar is not None:
+            polar[:] = np.concatenate([np.full(n_azimuth, u_mean[0]), u_mean[1:]]).reshape(n_radii, n_azimuth)
+        reduced = proj @ series
+        return RotorWind(t, np.full(n_out, u_mean[0]), reduced[0], reduced[1], reduced[2], polar, radii, psi, meta)
 
-    turbulent = v > 0.0 and ti > 0.0
-    if turbulent:
-        freqs = np.fft.rfftfreq(n_fft, dt)
-        keep = np.flatnonzero((freqs > 0.0) & (freqs < 0.5 / dt))
-        amp = np.sqrt(2.0 * kaimal_spectrum(freqs[keep], v, ti, hub_height) / (n_fft * dt)) * (0.5 * n_fft)
-        n_low = int(np.searchsorted(freqs[keep], f_coherent, side="right"))
-        low, high = keep[:n_low], keep[n_low:]
-        lc = turbulence_length_scale(hub_height)
-        z_low = np.exp(1j * rng.uniform(0.0, 2.0 * np.pi, (n_points, n_low)))
-        coef_low = np.empty((n_points, n_low), dtype=complex)
-        for start in range(0, n_low, _CHOLESKY_CHUNK):
-            sl = slice(start, min(start + _CHOLESKY_CHUNK, n_low))
-            decay = 12.0 * np.sqrt((freqs[low[sl]] / v) ** 2 + (0.12 / lc) ** 2)
-            coh = np.exp(-decay[:, None, None] * dist[None, :, :])
-            chol = np.linalg.cholesky(coh)  # exponential kernel: positive definite for distinct points
-            coef_low[:, sl] = np.einsum("fjk,kf->jf", chol, z_low[:, sl]) * amp[sl]
-        del z_low
-        amp_high = amp[n_low:]
-        spectrum = np.zeros(freqs.size, dtype=complex)
-    for j in range(n_points):
-        if turbulent:
-            spectrum[low] = coef_low[j]
-            spectrum[high] = amp_high * np.exp(1j * rng.uniform(0.0, 2.0 * np.pi, high.size))
-            # irfft gives (1/N) sum_k X_k e^{2 pi i k m / N} + c.c.; the N/2 in amp makes it sum_k Re(X_k e^{i w_k t})
-            series = irfft(spectrum, n=n_fft)[:n_out] + u_mean[j]
-        else:
-            series = np.full(n_out, u_mean[j])
-        reduced += proj[:, j : j + 1] * series
-        if j == 0:
-            hub = series.copy()
-            if polar is not None:
-                polar[:, 0, :] = series[:, None]
-        elif polar is not None:
-            ring, az = divmod(j - 1, n_azimuth)
-            polar[:, ring + 1, az] = series
+    freqs = np.fft.rfftfreq(n_fft, dt)
+    keep = np.flatnonzero((freqs > 0.0) & (freqs < 0.5 / dt))
+    amp = np.sqrt(2.0 * kaimal_spectrum(freqs[keep], v, ti, hub_height) / (n_fft * dt)) * (0.5 * n_fft)
+    n_low = int(np.searchsorted(freqs[keep], f_coherent, side="right"))
+    low, high = keep[:n_low], keep[n_low:]
+    coef_low = _coherent_coefficients(rng, freqs[low], amp[:n_low], dist, v, turbulence_length_scale(hub_height))
+    amp_high = amp[n_low:]
+    reduced = np.zeros((3, n_out))
+    hub = np.empty(0)
+    # points in blocks (one batched inverse FFT each, memory bounded); the random phases above the coherent
+    # band are drawn point after point, as one draw per point would
+    block = max(1, min(n_points, _FFT_BLOCK_VALUES // n_fft))
+    for j0 in range(0, n_points, block):
+        pts = np.arange(j0, min(j0 + block, n_points))
+        spectrum = np.zeros((pts.size, freqs.size), dtype=complex)
+        spectrum[:, low] = coef_low[pts]
+        phase = rng.uniform(0.0, 2.0 * np.pi, (pts.size, high.size))
+        spectrum.real[:, high] = amp_high * np.cos(phase)  # amp_high e^{i phase}, without a complex exp
+        spectrum.imag[:, high] = amp_high * np.sin(phase)
+        # irfft gives (1/N) sum_k X_k e^{2 pi i k m / N} + c.c.; the N/2 in amp makes it sum_k Re(X_k e^{i w_k t})
+        series = irfft(spectrum, n=n_fft, axis=-1)[:, :n_out] + u_mean[pts, None]
+        reduced += proj[:, pts] @ series
+        if j0 == 0:
+            hub = series[0].copy()
+        if polar is not None:  # point j >= 1 is column n_azimuth - 1 + j of the flattened rings
+            ring_pts = pts > 0
+            polar.reshape(n_out, n_radii * n_azimuth)[:, n_azimuth - 1 + pts[ring_pts]] = series[ring_pts].T
+            if j0 == 0:
+                polar[:, 0, :] = series[0][:, None]
     return RotorWind(t, hub, reduced[0], reduced[1], reduced[2], polar, radii, psi, meta)
