@@ -26,7 +26,15 @@ run again. A task that raises is retried (``retries`` times), then recorded as f
 reported; it is never dropped silently. At the end the summary -- the same JSON as ``fowt-env compare --json``,
 plus a ``"failed"`` list if any task failed -- goes to ``DIR/summary.json``. ``DIR/campaign.json`` holds the
 settings: a directory is never resumed with other settings (the grid may grow: added seeds or cases only run the
-new tasks).
+new tasks). One campaign at a time runs in a directory: it holds an exclusive lock on ``DIR/.lock`` (``flock``,
+released when the process ends, even when it is killed), and a second run on the same directory stops at once
+with :class:`CampaignBusyError` naming the holder's PID and host (a lock on a network file system is only as good
+as that file system's ``flock``). Files are replaced through temporary files of unique names.
+
+Security: a ``tcp://`` scheduler runs the tasks and sends their results back pickled, and the client unpickles
+them: whoever controls that address (or the network path to it) can run code in this process. Addresses other
+than loopback are refused unless the connection uses TLS (``tls://`` with a security configuration, see
+:func:`parse_scheduler`) or ``insecure=True`` (``--insecure``) says the network is trusted.
 
 Examples
 --------
@@ -59,11 +67,15 @@ from typing import Any
 from .compare import CompareResult, CompareSettings, _lyapunov_request, _one_blas_thread, grid_units
 
 __all__ = [
+    "LOCK_FILE",
     "LYAPUNOV_KEY",
+    "CampaignBusyError",
     "SCHEDULER_HELP",
     "CampaignResult",
+    "SECURITY_WARNING",
     "ProgressExecutor",
     "SerialExecutor",
+    "load_security",
     "parse_scheduler",
     "run_campaign",
     "task_label",
@@ -78,6 +90,8 @@ SCHEDULER_HELP = ("serial (default), threads:N, processes:N, local:N (a Dask Loc
                   "or tcp://HOST:PORT (an existing Dask cluster's scheduler)")
 
 RESULTS_FILE, SUMMARY_FILE, MANIFEST_FILE = "results.jsonl", "summary.json", "campaign.json"
+LOCK_FILE = ".lock"
+"""Held (``flock``, exclusive) by the campaign running in a directory; it names the holder's PID and host."""
 _FORMAT = 1
 
 
@@ -144,8 +158,81 @@ def _distributed(spec: str):
     return distributed
 
 
+SECURITY_WARNING = ("Dask sends task results pickled and this client unpickles them: whoever controls a "
+                    "tcp:// scheduler's address (or the network to it) can run code in this process")
+
+
+def _is_loopback(host: str | None) -> bool:
+    import ipaddress
+
+    if host is None:
+        return False
+    if host.lower() in ("localhost", "localhost.localdomain"):
+        return True
+    try:
+        return ipaddress.ip_address(host.strip("[]")).is_loopback
+    except ValueError:
+        return False
+
+
+def load_security(path: str | os.PathLike[str]) -> Any:
+    """A Dask ``distributed.Security`` (TLS) from a YAML or JSON file.
+
+    The file holds either Dask's own configuration layout (``distributed: comm: {require-encryption: true, tls:
+    {ca-file: ..., client: {cert: ..., key: ...}}}``, as in ``~/.config/dask/*.yaml``) or the keyword arguments of
+    ``distributed.Security`` (``tls_ca_file``, ``tls_client_cert``, ``tls_client_key``, ``require_encryption``).
+    Relative certificate paths are taken from the file's folder.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The security file.
+
+    Returns
+    -------
+    distributed.Security
+
+    Raises
+    ------
+    ValueError
+        A missing or unreadable file, unknown keys, or a certificate file that does not exist.
+    """
+    import yaml
+
+    p = Path(path)
+    try:
+        data = yaml.safe_load(p.read_text())
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        raise ValueError(f"scheduler security file {str(p)!r}: cannot read it ({' '.join(str(exc).split())})") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"scheduler security file {str(p)!r}: expected a mapping (Dask's 'distributed: comm: tls:' "
+                         "layout or distributed.Security keywords)")
+    distributed = _distributed("tls://")
+    if "distributed" in data:  # Dask's configuration layout
+        tls = (data.get("distributed") or {}).get("comm") or {}
+        flat = {"require_encryption": tls.get("require-encryption")}
+        t = tls.get("tls") or {}
+        flat.update(tls_ca_file=t.get("ca-file"), tls_ciphers=t.get("ciphers"),
+                    tls_client_cert=(t.get("client") or {}).get("cert"),
+                    tls_client_key=(t.get("client") or {}).get("key"))
+        data = {k: v for k, v in flat.items() if v is not None}
+    for key in ("tls_ca_file", "tls_client_cert", "tls_client_key"):
+        value = data.get(key)
+        if isinstance(value, str) and "-----BEGIN" not in value:  # a path, not PEM text
+            full = (p.parent / value).expanduser() if not Path(value).expanduser().is_absolute() else \
+                Path(value).expanduser()
+            if not full.is_file():
+                raise ValueError(f"scheduler security file {str(p)!r}: {key} {str(full)!r} does not exist")
+            data[key] = str(full)
+    try:
+        return distributed.Security(**data)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"scheduler security file {str(p)!r}: {exc}") from None
+
+
 @contextmanager
-def parse_scheduler(spec: str | None = "serial", **cluster_options: Any) -> Iterator[Executor]:
+def parse_scheduler(spec: str | None = "serial", *, security: Any = None, insecure: bool = False,
+                    **cluster_options: Any) -> Iterator[Executor]:
     """An executor for a scheduler spec, as a context manager that closes what it started.
 
     Parameters
@@ -155,6 +242,14 @@ def parse_scheduler(spec: str | None = "serial", **cluster_options: Any) -> Iter
         ``"local:N"``: a Dask distributed ``LocalCluster`` of N single-threaded worker processes (no dashboard);
         ``"tcp://HOST:PORT"`` (or ``tls://``...): the scheduler of an existing Dask cluster, whose workers must be
         able to import fowt_env (same version) -- the cluster is left running, only the client is closed.
+        **Trust**: Dask sends the results pickled and this client unpickles them, so whoever controls that address
+        can run code here. A ``tcp://`` address other than loopback is refused unless ``insecure=True``; use
+        ``tls://`` with `security` (or Dask's own TLS configuration) across a network.
+    security : distributed.Security, str or path-like, optional
+        TLS credentials for a ``tls://`` scheduler: a ``Security`` object or a file for :func:`load_security`.
+        Default: Dask's configuration (``distributed.comm.tls.*`` in ``~/.config/dask`` or ``DASK_*`` variables).
+    insecure : bool
+        Accept a plain ``tcp://`` scheduler that is not on this machine (a trusted, private network).
     **cluster_options
         For ``local:N``: extra ``LocalCluster`` keyword arguments (e.g. ``processes=False`` for in-process
         workers); for ``tcp://``: extra ``Client`` keyword arguments (e.g. ``timeout="30s"``).
@@ -167,12 +262,15 @@ def parse_scheduler(spec: str | None = "serial", **cluster_options: Any) -> Iter
     Raises
     ------
     ValueError
-        An unknown spec, a bad worker count, no Dask scheduler at the address, or workers without fowt-env.
+        An unknown spec, a bad worker count, a plain ``tcp://`` address beyond loopback without `insecure`, a bad
+        security file, no Dask scheduler at the address, or workers without fowt-env.
     """
     spec = "serial" if spec is None else str(spec).strip()
     kind, colon, arg = spec.partition(":")
     if cluster_options and kind not in ("local", "tcp", "tls", "ucx", "inproc"):
         raise ValueError(f"scheduler {spec!r} takes no options (got {sorted(cluster_options)})")
+    if security is not None and "://" not in spec:
+        raise ValueError(f"scheduler {spec!r}: a security configuration applies to tcp:// or tls:// schedulers only")
     if spec == "serial":
         yield SerialExecutor()
     elif kind == "threads" and colon:
@@ -195,11 +293,26 @@ def parse_scheduler(spec: str | None = "serial", **cluster_options: Any) -> Iter
         with distributed.LocalCluster(**options) as cluster, distributed.Client(cluster) as client:
             yield client.get_executor(pure=False)
     elif "://" in spec:
+        from urllib.parse import urlsplit
+
+        try:
+            host = urlsplit(spec).hostname
+        except ValueError:
+            host = None
+        if kind not in ("tls", "inproc") and not _is_loopback(host) and not insecure:
+            raise ValueError(f"scheduler {spec!r}: refused, {SECURITY_WARNING}; across a network use tls://HOST:PORT "
+                             "with --scheduler-security FILE (or Dask's TLS configuration), or pass --insecure on a "
+                             "network you trust")
         distributed = _distributed(spec)
+        if security is not None and not isinstance(security, distributed.Security):
+            security = load_security(security)
+        if security is not None:
+            cluster_options = {"security": security, **cluster_options}
         try:
             client = distributed.Client(spec, **{"timeout": "10s", **cluster_options})
         except (OSError, TimeoutError) as exc:
-            raise ValueError(f"scheduler {spec!r}: cannot connect to a Dask scheduler there ({exc})") from None
+            raise ValueError(f"scheduler {spec!r}: cannot connect to a Dask scheduler there "
+                             f"({' '.join(str(exc).split())})") from None
         with client:
             _check_workers(client, spec)
             yield client.get_executor(pure=False)
@@ -298,8 +411,59 @@ class _Journal:
         self.fh.close()
 
 
+class CampaignBusyError(ValueError):
+    """The campaign directory is in use by another running campaign (its PID is in the message)."""
+
+
+@contextmanager
+def _exclusive(out: Path) -> Iterator[None]:
+    """Hold an exclusive lock on the campaign directory ``out`` (``out/.lock``, ``flock``) while the block runs.
+
+    The lock dies with its process (a killed campaign leaves no stale lock); the file keeps the holder's PID and
+    host for the message another run gets. Where ``fcntl`` is missing (Windows) no lock is taken.
+    """
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - Windows
+        log.warning("no file locking on this platform: do not run two campaigns on %s at once", out)
+        yield
+        return
+    path = out / LOCK_FILE
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 200, 0).decode("utf-8", "replace").strip() or "a process that has not said which"
+            raise CampaignBusyError(
+                f"{out} is in use by another running campaign ({holder}); wait for it to finish or use another "
+                "directory") from None
+        os.ftruncate(fd, 0)
+        import socket
+
+        os.pwrite(fd, f"PID {os.getpid()} on {socket.gethostname()}\n".encode(), 0)
+        try:
+            yield
+        finally:
+            os.ftruncate(fd, 0)  # released: no holder to name (the lock itself goes with the descriptor)
+    finally:
+        os.close(fd)
+
+
+def _replace_atomically(dest: Path, text: str) -> None:
+    """Write ``text`` to a temporary file of a unique name beside ``dest``, then move it onto ``dest``."""
+    import uuid
+
+    tmp = dest.with_name(f".{dest.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp")
+    try:
+        tmp.write_text(text)
+        os.replace(tmp, dest)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
 def _prepare_dir(out: Path, settings: CompareSettings, fresh: bool) -> None:
-    out.mkdir(parents=True, exist_ok=True)
     manifest = out / MANIFEST_FILE
     mine = json.loads(json.dumps(settings.to_dict(), default=str))
     if fresh:
@@ -316,9 +480,8 @@ def _prepare_dir(out: Path, settings: CompareSettings, fresh: bool) -> None:
                              f"another directory, the same settings, or start afresh (fresh=True, --fresh)")
     elif (out / RESULTS_FILE).exists():
         raise ValueError(f"{out / RESULTS_FILE} exists without {MANIFEST_FILE}; use another directory")
-    tmp = manifest.with_suffix(".tmp")
-    tmp.write_text(json.dumps({"kind": "fowt-env campaign", "format": _FORMAT, "settings": mine}, indent=1))
-    os.replace(tmp, manifest)
+    _replace_atomically(manifest, json.dumps({"kind": "fowt-env campaign", "format": _FORMAT, "settings": mine},
+                                             indent=1))
 
 
 # ------------------------------------------------------------------------------------------------ result
@@ -453,6 +616,8 @@ def run_campaign(
     ------
     ValueError
         Bad grid arguments (as :func:`compare`), or ``out`` holds a campaign with other settings.
+    CampaignBusyError
+        (a ValueError) ``out`` is in use by another running campaign; the message names its PID and host.
     KeyboardInterrupt
         From a task or ``on_record``: the campaign stops, tasks not yet finished are cancelled, the journal
         keeps what finished.
@@ -470,6 +635,16 @@ def run_campaign(
     if lyap == {}:
         calls[LYAPUNOV_KEY] = ("lyapunov", (settings,))
     out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    with _exclusive(out):  # one campaign per directory at a time (--fresh deletes what another would append to)
+        return _run_locked(out, calls, settings, fresh, lyap, executor, retries, progress, keep_traces,
+                           max_in_flight, on_record)
+
+
+def _run_locked(out: Path, calls: dict[tuple | str, tuple], settings: CompareSettings, fresh: bool, lyap: Any,
+                executor: Executor | None, retries: int, progress: bool | None, keep_traces: bool,
+                max_in_flight: int | None, on_record: Callable[[dict[str, Any]], None] | None) -> CampaignResult:
+    """:func:`run_campaign` once its arguments are checked and the directory is locked."""
     _prepare_dir(out, settings, fresh)
     (out / SUMMARY_FILE).unlink(missing_ok=True)  # a summary is only there when it matches the journal
     journal_path = out / RESULTS_FILE
@@ -550,9 +725,7 @@ def run_campaign(
     camp = CampaignResult(out, result, n_tasks=len(calls), ran=len(attempts),
                           reused=len(calls) - len(attempts), retried=retried,
                           failed=[failed[k] for k in calls if k in failed], total_s=total)
-    tmp = out / (SUMMARY_FILE + ".tmp")
-    tmp.write_text(json.dumps(camp.to_dict(), indent=1))
-    os.replace(tmp, out / SUMMARY_FILE)
+    _replace_atomically(out / SUMMARY_FILE, json.dumps(camp.to_dict(), indent=1))
     return camp
 
 

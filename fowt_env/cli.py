@@ -596,7 +596,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     total = len(grid_units(scenarios, estimators, **{k: kwargs[k] for k in ("cases", "seeds", "update_intervals",
                                                                             "settings")}))
     total += kwargs["lyapunov_time"] == "auto"  # the Lyapunov estimate runs as one more task
-    with _scheduler(args.scheduler, "compare", total) as executor:
+    with _scheduler(args.scheduler, "compare", total, args.scheduler_security, args.insecure) as executor:
         res = compare(scenarios, estimators, executor=executor, **kwargs)
     print(res.summary())
     if args.json:
@@ -610,12 +610,15 @@ def _cmd_compare(args: argparse.Namespace) -> int:
 
 
 @contextlib.contextmanager
-def _scheduler(spec: str | None, desc: str, total: int | None = None):
+def _scheduler(spec: str | None, desc: str, total: int | None = None, security: str | None = None,
+               insecure: bool = False):
     """The executor of ``--scheduler`` (None: none, compare's in-process default), with a progress bar of
     ``total`` tasks on stderr when it is a terminal."""
     from .campaign import ProgressExecutor, SerialExecutor, parse_scheduler
     from .progress import on_terminal
 
+    if spec is None and (security or insecure):
+        raise _UsageError("--scheduler-security and --insecure apply to --scheduler tcp:// or tls:// only")
     if spec is None:
         if not on_terminal():
             yield None
@@ -627,7 +630,7 @@ def _scheduler(spec: str | None, desc: str, total: int | None = None):
             wrapped.shutdown()
         return
 
-    with parse_scheduler(spec) as executor:
+    with parse_scheduler(spec, security=security, insecure=insecure) as executor:
         wrapped = ProgressExecutor(executor, total=total, desc=desc)
         try:
             yield wrapped
@@ -677,7 +680,7 @@ def _cmd_campaign(args: argparse.Namespace) -> int:
     scenarios, estimators, kwargs = _compare_request(args)
     if args.retries < 0:
         raise ValueError(f"--retries must be >= 0, got {args.retries}")
-    with parse_scheduler(args.scheduler) as executor:
+    with parse_scheduler(args.scheduler, security=args.scheduler_security, insecure=args.insecure) as executor:
         try:
             done = run_campaign(args.out, scenarios, estimators, executor=executor, retries=args.retries,
                                 progress=args.progress, keep_traces=bool(args.plot), fresh=args.fresh, **kwargs)
@@ -880,8 +883,16 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--plot", default=None, help="folder for the figures")
     c.add_argument("--scheduler", default=None, metavar="SPEC",
                    help="run the grid on: serial, threads:N, processes:N, local:N (a Dask LocalCluster of N worker "
-                        "processes) or tcp://HOST:PORT (an existing Dask cluster); the numbers do not depend on it "
-                        "(default: in this process)")
+                        "processes) or tcp://HOST:PORT / tls://HOST:PORT (an existing Dask cluster); the numbers do "
+                        "not depend on it (default: in this process). Trust: Dask sends results pickled and this "
+                        "program unpickles them, so whoever controls that address can run code here; tcp:// beyond "
+                        "this machine is refused without --insecure: use tls:// with --scheduler-security")
+    c.add_argument("--scheduler-security", default=None, metavar="FILE",
+                   help="TLS credentials for a tls:// scheduler: YAML/JSON in Dask's layout (distributed: comm: "
+                        "tls: ca-file, client: cert/key) or distributed.Security keywords (default: Dask's own "
+                        "configuration)")
+    c.add_argument("--insecure", action="store_true",
+                   help="accept a plain tcp:// scheduler on another machine (only on a network you trust)")
     c.set_defaults(func=_cmd_compare)
 
     g = sub.add_parser(
