@@ -1,0 +1,76 @@
+"""The model-error axis (issue 17): records from a perturbed truth model, model-based sensors on the nominal one.
+
+Expectations from closed forms (frequency ~ sqrt(stiffness / mass), the reference platform mass of Jonkman
+2010, the NREL 5 MW blade's mass and centre of mass) and from the physics of a filter given the wrong model,
+never from numbers the harness printed.
+"""
+
+import numpy as np
+import pytest
+
+import surrogates
+from fowt_env import compare as C
+from surrogates.model_error import check_perturbations, perturbed_model
+
+NOMINAL = surrogates.FOWTModel()
+
+
+def _freq(model, label):
+    return model.modal_analysis().frequency(label)
+
+
+def test_tower_stiffness_moves_both_first_tower_modes_by_its_square_root():
+    soft = perturbed_model({"tower_stiffness": 0.95})
+    for label in ("tower_fa_1", "tower_ss_1"):
+        assert _freq(soft, label) / _freq(NOMINAL, label) == pytest.approx(np.sqrt(0.95), abs=0.002), label
+
+
+def test_mooring_stiffness_moves_surge_by_its_square_root():
+    # surge is restored by the mooring alone (a spar has no water-plane surge stiffness)
+    weak = perturbed_model({"mooring_stiffness": 0.7})
+    assert _freq(weak, "surge") / _freq(NOMINAL, "surge") == pytest.approx(np.sqrt(0.7), rel=0.01)
+    assert _freq(weak, "heave") == pytest.approx(_freq(NOMINAL, "heave"), rel=0.01)  # heave: hydrostatics
+
+
+def test_platform_mass_adds_three_percent_of_the_reference_spar_mass_to_surge():
+    heavy = perturbed_model({"platform_mass": 1.03})
+    # Jonkman 2010: platform mass 7,466,330 kg (DESIGN.md reference values)
+    assert heavy.structure.mass[0, 0] - NOMINAL.structure.mass[0, 0] == pytest.approx(0.03 * 7_466_330, rel=1e-3)
+
+
+def test_rotor_mass_imbalance_is_a_fraction_of_one_blades_first_mass_moment():
+    # NREL 5 MW blade: 17,740 kg, centre of mass 20.475 m from the root, hub radius 1.5 m (Jonkman et al. 2009)
+    m = perturbed_model({"rotor_mass_imbalance": 0.02})
+    assert m.harmonics.mass_imbalance == pytest.approx(0.02 * 17_740 * (20.475 + 1.5), rel=0.01)
+    assert perturbed_model({}).harmonics.mass_imbalance == NOMINAL.harmonics.mass_imbalance
+
+
+def test_drag_coefficient_scales_the_linearised_drag():
+    from surrogates.drag import drag_strips
+
+    d1 = perturbed_model({"drag_cd": 1.5}).system(surrogates.load_case(7)).drag  # linearised about OLC 7's sea
+    assert np.allclose(d1.coef, 1.5 * drag_strips().coef)
+
+
+def test_unknown_or_bad_perturbations_are_clear_errors():
+    with pytest.raises(ValueError, match="unknown perturbation 'tower_stifness'"):
+        check_perturbations({"tower_stifness": 0.9})
+    with pytest.raises(ValueError, match="> 0"):
+        check_perturbations({"tower_stiffness": 0.0})
+    with pytest.raises(ValueError, match="records from files are their own truth"):
+        C.CompareSettings(train_files=("a.npz",), test_files=("b.npz",), truth_effects={"drag_cd": 1.5})
+
+
+def test_truth_effects_change_the_records_not_the_kalman_model():
+    settings = C.CompareSettings(train_cases=(1,), train_duration=10.0, duration=10.0,
+                                 truth_effects={"tower_stiffness": 0.8})
+    noisy, truth = C.held_out_data(7, 0, settings)
+    own = surrogates.simulate(perturbed_model({"tower_stiffness": 0.8}), 7, duration=10.0, seed=0,
+                              return_truth=True)[1].planar("FA").y
+    assert np.array_equal(truth, own)
+    # the filter keeps the nominal linearisation: its first fore-aft tower mode is the nominal 0.49 Hz, not the
+    # truth's sqrt(0.8) x 0.49 = 0.44 Hz
+    kf = C._new_sensor("kalman", None, settings)
+    f = np.abs(np.linalg.eigvals(kf.system.A).imag) / (2 * np.pi)
+    assert np.min(np.abs(f - _freq(NOMINAL, "tower_fa_1"))) < 0.005
+    assert np.min(np.abs(f - np.sqrt(0.8) * _freq(NOMINAL, "tower_fa_1"))) > 0.03
