@@ -45,6 +45,7 @@ from .drag import DragStrips, drag_strips, wave_velocity_rao, with_relative_velo
 from .effects import resolve_effects
 from .load_cases import LoadCase, load_case
 from .oc3 import GRAVITY
+from .radiation import modal_radiation_damping
 from .structure import DOF_LABELS, N_DOF, Structure, build_structure
 
 __all__ = ["FOWTModel", "ModalResult", "LinearSystem", "RotorHarmonics", "SensorNoise", "STATE_NAMES", "INPUT_NAMES"]
@@ -400,7 +401,8 @@ class FOWTModel:
 
         m = st.mass
         k = st.stiffness + s_pd * st.stiffness_pdelta
-        c = st.damping.copy()
+        # the spar's WAMIT radiation damping at the tower modes' frequencies (surrogates.radiation)
+        c = st.damping + modal_radiation_damping(m, k)
         e_s = st.shaft_axis
         h_v = e_s @ st.hub_translation  # hub velocity along the shaft per qdot == generalised thrust direction
         r_s = e_s @ st.tower_top_rotation  # generalised force of a moment about the shaft at the tower top
