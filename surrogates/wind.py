@@ -396,6 +396,35 @@ _CHOLESKY_CHUNK = 512  # frequencies factored per batch (memory: chunk * n_point
 _FFT_BLOCK_VALUES = 1 << 21  # points per batched inverse FFT: at most this many samples (16 MB of float64)
 
 
+def _coherent_groups(dist: np.ndarray, f_hz: np.ndarray, mean_speed: float) -> list[tuple[slice, list[np.ndarray]]]:
+    """Split increasing frequencies into runs over which the points fall into the same coherent groups.
+
+    At frequency f the points form the connected components of the graph joining every pair whose coherence
+    bound ``exp(-12 f d / V)`` is at least :data:`_COHERENCE_FLOOR` (``d <= V ln(1/floor) / (12 f)``): pairs in
+    different components are all below the floor, as every pair is above ``coherent_max_hz``. These components
+    are the single-linkage clusters of the points cut at that distance. Returns ``(frequency slice, groups)``
+    with each group's point indices in increasing order; the components only split as f grows, so the runs are
+    contiguous.
+    """
+    from scipy.cluster.hierarchy import fcluster, linkage
+    from scipy.spatial.distance import squareform
+
+    reach = mean_speed * np.log(1.0 / _COHERENCE_FLOOR) / (12.0 * np.maximum(f_hz, 1e-300))
+    tree = linkage(squareform(dist, checks=False), method="single")
+    merges = np.searchsorted(np.sort(tree[:, 2]), reach, side="right")  # merges within reach, per frequency
+    runs: list[tuple[slice, list[np.ndarray]]] = []
+    last: np.ndarray | None = None
+    for start in np.flatnonzero(np.diff(merges, prepend=-1)):
+        labels = fcluster(tree, reach[start], criterion="distance")
+        if last is not None and np.array_equal(labels, last):
+            continue
+        if runs:
+            runs[-1] = (slice(runs[-1][0].start, int(start)), runs[-1][1])
+        runs.append((slice(int(start), f_hz.size), [np.flatnonzero(labels == c) for c in np.unique(labels)]))
+        last = labels
+    return runs
+
+
 def _coherent_coefficients(rng: np.random.Generator, f_hz: np.ndarray, amp: np.ndarray, dist: np.ndarray,
                            mean_speed: float, coherence_scale: float) -> np.ndarray:
     """Fourier coefficients of the grid points in the coherent band (Veers): ``amp L(f) z(f)`` per frequency.
@@ -405,7 +434,7 @@ def _coherent_coefficients(rng: np.random.Generator, f_hz: np.ndarray, amp: np.n
     rng : numpy.random.Generator
         Draws the unit-amplitude random phases ``z``, shape ``(n_points, n_freq)``, first of all.
     f_hz : ndarray (n_freq,)
-        Frequencies (Hz).
+        Frequencies (Hz), increasing.
     amp : ndarray (n_freq,)
         Point amplitudes (the spectrum's, scaled for the inverse FFT).
     dist : ndarray (n_points, n_points)
@@ -417,7 +446,11 @@ def _coherent_coefficients(rng: np.random.Generator, f_hz: np.ndarray, amp: np.n
     -------
     ndarray (n_points, n_freq), complex
         ``L`` is the Cholesky factor of the coherence matrix ``exp(-a(f) dist)``, so the coefficients have the
-        cross-spectral matrix ``amp^2 Coh``.
+        cross-spectral matrix ``amp^2 Coh``. Where the points split into groups whose mutual coherences are all
+        below :data:`_COHERENCE_FLOOR` (:func:`_coherent_groups`; on the polar grid the rings part above about
+        ``0.05 V`` Hz, the outer rings' own points soon after), each group's coherence is factored on its own: the
+        same floor as above ``coherent_max_hz``, and a fraction of the cost (the factorisation of the whole
+        grid is the bulk of the synthesis).
     """
     n_points, n_freq = dist.shape[0], f_hz.size
     phase = rng.uniform(0.0, 2.0 * np.pi, (n_points, n_freq))
@@ -426,13 +459,20 @@ def _coherent_coefficients(rng: np.random.Generator, f_hz: np.ndarray, amp: np.n
     z[:, :, 1] = np.sin(phase).T
     del phase
     coef = np.empty((n_points, n_freq), dtype=complex)
-    for start in range(0, n_freq, _CHOLESKY_CHUNK):
-        sl = slice(start, min(start + _CHOLESKY_CHUNK, n_freq))
-        decay = 12.0 * np.sqrt((f_hz[sl] / mean_speed) ** 2 + (0.12 / coherence_scale) ** 2)
-        coh = np.exp(-decay[:, None, None] * dist[None, :, :])
-        chol = np.linalg.cholesky(coh)  # exponential kernel: positive definite for distinct points
-        lz = chol @ z[sl]  # (f, j, 2): L applied to the cos and sin parts of z
-        coef[:, sl] = (lz[:, :, 0] + 1j * lz[:, :, 1]).T * amp[sl]
+    for run, groups in _coherent_groups(dist, f_hz, mean_speed):
+        for pts in groups:
+            if pts.size == 1:  # coherence 1 with itself: L = 1
+                coef[pts[0], run] = (z[run, pts[0], 0] + 1j * z[run, pts[0], 1]) * amp[run]
+                continue
+            d = dist[np.ix_(pts, pts)]
+            chunk = max(1, _CHOLESKY_CHUNK * n_points**2 // pts.size**2)
+            for start in range(run.start, run.stop, chunk):
+                sl = slice(start, min(start + chunk, run.stop))
+                decay = 12.0 * np.sqrt((f_hz[sl] / mean_speed) ** 2 + (0.12 / coherence_scale) ** 2)
+                coh = np.exp(-decay[:, None, None] * d[None, :, :])
+                chol = np.linalg.cholesky(coh)  # exponential kernel: positive definite for distinct points
+                lz = chol @ z[sl][:, pts]  # (f, j, 2): L applied to the cos and sin parts of z
+                coef[pts, sl] = (lz[:, :, 0] + 1j * lz[:, :, 1]).T * amp[sl]
     return coef
 
 
@@ -596,9 +636,12 @@ def synthesize_rotor_wind(
     ``coherent_max_hz = V ln(1e4) / (12 d_min)`` (``d_min`` the closest pair of points) every coherence is below
     1e-4, ``L`` is the identity to that accuracy and the points are synthesised independently, so the spectrum
     reaches the Nyquist frequency ``1 / (2 dt)`` at the cost of an FFT per point (the Cholesky factors are only
-    needed up to about 1-2 Hz). As in :func:`synthesize_wind` the series are the first ``n = round(duration/dt)``
-    samples of a record periodic over ``n_fft = next_fast_len(n)``; variance below ``df`` and at the Nyquist
-    frequency is absent.
+    needed up to about 1-2 Hz). Below it the same floor applies group by group: from the frequency where all
+    coherences between two groups of points (on the polar grid: the hub and the rings, then the outer rings'
+    own points) are below 1e-4, each group's coherence matrix is factored on its own (``L`` block diagonal;
+    the whole grid's factorisation, the bulk of the cost, is needed only up to about ``0.05 V`` Hz). As in
+    :func:`synthesize_wind` the series are the first ``n = round(duration/dt)`` samples of a record periodic
+    over ``n_fft = next_fast_len(n)``; variance below ``df`` and at the Nyquist frequency is absent.
 
     The disc mean and gradients come from :func:`rotor_plane_fit` on the grid (area weights). With the default
     5 x 12 grid their variances are within about 1 % of those of the continuous disc (checked against a
@@ -698,29 +741,34 @@ def synthesize_rotor_wind(
     keep = np.flatnonzero((freqs > 0.0) & (freqs < 0.5 / dt))
     amp = np.sqrt(2.0 * kaimal_spectrum(freqs[keep], v, ti, hub_height) / (n_fft * dt)) * (0.5 * n_fft)
     n_low = int(np.searchsorted(freqs[keep], f_coherent, side="right"))
-    low, high = keep[:n_low], keep[n_low:]
+    # keep is the contiguous bins 1 .. (Nyquist excluded): the coherent band, then the rest
+    low = slice(int(keep[0]), int(keep[0]) + n_low) if keep.size else slice(0, 0)
+    high = slice(low.stop, int(keep[-1]) + 1 if keep.size else 0)
     coef_low = _coherent_coefficients(rng, freqs[low], amp[:n_low], dist, v, turbulence_length_scale(hub_height))
     amp_high = amp[n_low:]
+    n_high = amp_high.size
     reduced = np.zeros((3, n_out))
     hub = np.empty(0)
+    flat = None if polar is None else polar.reshape(n_out, n_radii * n_azimuth)  # point j >= 1: column j + n_az - 1
     # points in blocks (one batched inverse FFT each, memory bounded); the random phases above the coherent
     # band are drawn point after point, as one draw per point would
     block = max(1, min(n_points, _FFT_BLOCK_VALUES // n_fft))
     for j0 in range(0, n_points, block):
-        pts = np.arange(j0, min(j0 + block, n_points))
-        spectrum = np.zeros((pts.size, freqs.size), dtype=complex)
-        spectrum[:, low] = coef_low[pts]
-        phase = rng.uniform(0.0, 2.0 * np.pi, (pts.size, high.size))
+        j1 = min(j0 + block, n_points)
+        spectrum = np.zeros((j1 - j0, max(high.stop, 1)), dtype=complex)  # irfft zero-pads up to Nyquist
+        spectrum[:, low] = coef_low[j0:j1]
+        phase = rng.uniform(0.0, 2.0 * np.pi, (j1 - j0, n_high))
         spectrum.real[:, high] = amp_high * np.cos(phase)  # amp_high e^{i phase}, without a complex exp
         spectrum.imag[:, high] = amp_high * np.sin(phase)
         # irfft gives (1/N) sum_k X_k e^{2 pi i k m / N} + c.c.; the N/2 in amp makes it sum_k Re(X_k e^{i w_k t})
-        series = irfft(spectrum, n=n_fft, axis=-1)[:, :n_out] + u_mean[pts, None]
-        reduced += proj[:, pts] @ series
+        series = irfft(spectrum, n=n_fft, axis=-1)[:, :n_out]
+        series += u_mean[j0:j1, None]
+        reduced += proj[:, j0:j1] @ series
         if j0 == 0:
             hub = series[0].copy()
-        if polar is not None:  # point j >= 1 is column n_azimuth - 1 + j of the flattened rings
-            ring_pts = pts > 0
-            polar.reshape(n_out, n_radii * n_azimuth)[:, n_azimuth - 1 + pts[ring_pts]] = series[ring_pts].T
-            if j0 == 0:
+            if flat is not None:
                 polar[:, 0, :] = series[0][:, None]
+        if flat is not None:
+            r0 = max(j0, 1)
+            flat[:, r0 + n_azimuth - 1: j1 + n_azimuth - 1] = series[r0 - j0:].T
     return RotorWind(t, hub, reduced[0], reduced[1], reduced[2], polar, radii, psi, meta)
