@@ -182,9 +182,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         raise _UsageError("--wind-file needs --replay RECORD")
     from .progress import simulation_bar
 
-    model = surrogates.FOWTModel(_parse_effects(args.effects))
     case = _case(args.case)
     with simulation_bar(args.duration + 60.0, "simulate") as (bar, hook):  # 60 s: simulate's default transient
+        model = surrogates.FOWTModel(_parse_effects(args.effects))
         rec, wall = _timed_simulation(model, case, duration=args.duration, dt=args.dt, seed=args.seed,
                                       noise=not args.no_noise, on_progress=hook)
         bar.update(bar.total - bar.n)  # the last samples' rounding
@@ -283,28 +283,32 @@ def _parse_faults(specs: list[str]):
 
 
 def _cmd_episode(args: argparse.Namespace) -> int:
-    import surrogates
-
-    from .env import SparEnv
-
-    env = SparEnv(case=_case(args.case), dt=args.dt, plane=args.plane,
-                  faults=_parse_faults(args.fault or []), model=surrogates.FOWTModel(_parse_effects(args.effects)))
-    n = int(round(args.duration / env.control_dt))
-    obs, info = env.reset(seed=args.seed)
-    meas, truth, t = [], [], []
-
-    def keep(o, inf):
-        meas.append(np.where(o["mask"].astype(bool), o["sensors"], np.nan))
-        truth.append(inf["truth"])
-        t.append(inf["time"])
-
-    keep(obs, info)
-    zero = np.zeros(2, dtype=np.float32)
     from .progress import progress_bar
 
-    t0 = time.perf_counter()
-    terminated = False
-    with progress_bar(n - 1, "episode", unit="steps", progress=None) as bar:
+    # one bar from the imports and the set-up (the warm-up simulates 60 s and the first forcing chunk) to the files
+    with progress_bar(max(1, int(round(args.duration / args.dt)) - 1), "episode", unit="steps", progress=None) as bar:
+        bar.set_postfix_str("set-up and warm-up", refresh=False)
+        import surrogates
+
+        from .env import SparEnv
+
+        env = SparEnv(case=_case(args.case), dt=args.dt, plane=args.plane, faults=_parse_faults(args.fault or []),
+                      model=surrogates.FOWTModel(_parse_effects(args.effects)))
+        n = int(round(args.duration / env.control_dt))
+        bar.total = max(1, n - 1)
+        obs, info = env.reset(seed=args.seed)
+        meas, truth, t = [], [], []
+
+        def keep(o, inf):
+            meas.append(np.where(o["mask"].astype(bool), o["sensors"], np.nan))
+            truth.append(inf["truth"])
+            t.append(inf["time"])
+
+        keep(obs, info)
+        zero = np.zeros(2, dtype=np.float32)
+        bar.set_postfix_str("stepping", refresh=False)
+        t0 = time.perf_counter()
+        terminated = False
         for _ in range(n - 1):
             obs, _, term, _, info = env.step(zero)
             keep(obs, info)
@@ -312,17 +316,18 @@ def _cmd_episode(args: argparse.Namespace) -> int:
             if term:
                 terminated = True
                 break
+        wall = time.perf_counter() - t0
+        meta = {"source": "fowt-env episode", "case": env.case.to_dict(), "seed": args.seed,
+                "faults": [repr(f) for f in env.faults], "plane": args.plane, "dt": env.dt}
+        units = surrogates.FOWTModel.units(env.channels)
+        measured = surrogates.Record(np.array(t), np.array(meas), env.channels, units, {**meta, "kind": "measured"})
+        true_rec = surrogates.Record(np.array(t), np.array(truth), env.channels, units, {**meta, "kind": "truth"})
+        out = Path(args.out)
+        bar.set_postfix_str(f"writing {out.name}")
+        p1 = _save_record(measured, out)
+        p2 = _save_record(true_rec, out.with_name(out.stem + "_truth" + (out.suffix or ".npz")))
     if terminated:
         print("episode terminated (physical failure)")
-    wall = time.perf_counter() - t0
-    meta = {"source": "fowt-env episode", "case": env.case.to_dict(), "seed": args.seed,
-            "faults": [repr(f) for f in env.faults], "plane": args.plane, "dt": env.dt}
-    units = surrogates.FOWTModel.units(env.channels)
-    measured = surrogates.Record(np.array(t), np.array(meas), env.channels, units, {**meta, "kind": "measured"})
-    true_rec = surrogates.Record(np.array(t), np.array(truth), env.channels, units, {**meta, "kind": "truth"})
-    out = Path(args.out)
-    p1 = _save_record(measured, out)
-    p2 = _save_record(true_rec, out.with_name(out.stem + "_truth" + (out.suffix or ".npz")))
     lost = np.isnan(measured.y).mean()
     print(f"{len(t)} steps ({t[-1]:.1f} s) in {wall:.2f} s; {100 * lost:.1f} % of samples lost")
     print(f"wrote {p1} (measured, NaN where lost)\nwrote {p2} (noise-free truth)")
@@ -431,7 +436,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
         Path(args.json).write_text(json.dumps(res.to_dict(), indent=2))
         print(f"wrote {args.json}")
     if args.plot:
-        for path in res.plot(args.plot):
+        for path in res.plot(args.plot, progress=None):
             print(f"wrote {path}")
     return 0
 
@@ -543,7 +548,7 @@ def _demo_identification(rec, model, case, folder: Path):
     t0 = time.perf_counter()
     res = identify(rec, plane="FA", reference=ref, progress=None)
     print(res.summary())
-    paths = res.plot(folder)
+    paths = res.plot(folder, progress=None)
     print(f"wrote {len(paths)} figures to {folder} ({time.perf_counter() - t0:.1f} s)")
     return res
 

@@ -23,6 +23,7 @@ with the rotor harmonics' tracks over it.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -323,29 +324,51 @@ class IdentificationResult:
                 lines.append(row)
         return "\n".join(lines)
 
-    def plot(self, folder: str | Path) -> list[Path]:
-        """Write the identification figures (PNG) into ``folder``; returns their paths."""
+    def plot(self, folder: str | Path, *, progress: bool | None = False) -> list[Path]:
+        """Write the identification figures (PNG) into ``folder``; returns their paths.
+
+        Parameters
+        ----------
+        folder : str or Path
+            Created if needed.
+        progress : bool or None
+            Progress bar of the figures on stderr (:func:`fowt_env.progress.progress_bar`): True, False
+            (default), None = on a terminal, after 2 s.
+
+        Returns
+        -------
+        list of Path
+        """
         from .plots import (
             eigenvalue_figure,
             singular_value_figure,
             spectrogram_figure,
             stabilization_figure,
         )
+        from .progress import progress_bar
 
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
-        paths = [eigenvalue_figure(self.dmd, self.dmd_modes, folder / "dmd_eigenvalues.png"),
-                 singular_value_figure(self.dmd, folder / "singular_values.png")]
+        jobs: list[tuple[str, Callable[[], Path]]] = [
+            ("DMD eigenvalues", lambda: eigenvalue_figure(self.dmd, self.dmd_modes, folder / "dmd_eigenvalues.png")),
+            ("singular values", lambda: singular_value_figure(self.dmd, folder / "singular_values.png"))]
         if self.ssi is not None and self._y is not None:
-            paths.append(stabilization_figure(self.ssi, self._y, self.dt, folder / "stabilization.png",
-                                              reference=self.reference))
+            jobs.append(("stabilisation diagram", lambda: stabilization_figure(
+                self.ssi, self._y, self.dt, folder / "stabilization.png", reference=self.reference)))
         if self._y is not None and self._spectrogram_channel is not None:
             j = self.channels.index(self._spectrogram_channel)
             tracks = None
             if self.harmonics and self._rotor_hz is not None:
                 tracks = {f"{row['order']:.0f}P": row["order"] * self._rotor_hz for row in self.harmonics}
-            paths.append(spectrogram_figure(self._y[:, j], self.dt, self._spectrogram_channel, self.units[j],
-                                            folder / "spectrogram.png", tracks=tracks))
+            jobs.append(("spectrogram", lambda: spectrogram_figure(
+                self._y[:, j], self.dt, self._spectrogram_channel, self.units[j], folder / "spectrogram.png",
+                tracks=tracks)))
+        paths = []
+        with progress_bar(len(jobs), "figures", unit="figures", progress=progress) as bar:
+            for name, job in jobs:
+                bar.set_postfix_str(name, refresh=False)
+                paths.append(job())
+                bar.update(1)
         return paths
 
 

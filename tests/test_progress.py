@@ -183,3 +183,26 @@ def test_simulate_replay_on_a_terminal_shows_the_records_seconds(tmp_path):
     bars = re.findall(r"replay: +\d+%\|[^|]*\| (\d+)/(\d+) s simulated \[\d\d:\d\d elapsed, ETA (\d\d:\d\d|\?)", out)
     assert bars and {total for _, total, _ in bars} == {"600"}, out  # the record's 600 s
     assert any(n == total for n, total, _ in bars) and any(eta != "?" for *_, eta in bars)
+
+
+
+def test_identify_plot_on_a_terminal_counts_its_figures(record, tmp_path):
+    """The figures (13.8 s for four on a busy 2-core machine, 600 s record) have their own bar."""
+    code, out = _run_on_a_terminal([*_identify_argv(record), "--no-ssi", "--rotor-speed", "none", "--plot",
+                                    str(tmp_path / "figs")])
+    assert code == 0, out
+    bars = re.findall(r"figures: +\d+%\|[^|]*\| (\d+)/(\d+) figures \[\d\d:\d\d elapsed, ETA (\d\d:\d\d|\?)", out)
+    assert bars and {total for _, total, _ in bars} == {"3"}, out  # eigenvalues, singular values, spectrogram
+    assert any(n == "3" for n, _, _ in bars) and len(list((tmp_path / "figs").glob("*.png"))) == 3
+
+
+def test_episode_on_a_terminal_shows_its_steps_from_the_set_up_on(tmp_path):
+    """The environment's set-up and warm-up (10-20 s on a busy machine) and the files written are inside the bar."""
+    code, out = _run_on_a_terminal([sys.executable, "-m", "fowt_env.cli", "episode", "--duration", "20",
+                                    "--out", str(tmp_path / "ep.npz")])
+    assert code == 0, out
+    bars = re.findall(r"episode: +\d+%\|[^|]*\| (\d+)/(\d+) steps \[\d\d:\d\d elapsed, ETA (\d\d:\d\d|\?)([^\]]*)\]",
+                      out)
+    assert bars and {total for _, total, _, _ in bars} == {"1599"}, out
+    assert any("set-up and warm-up" in phase for *_, phase in bars) and any(eta != "?" for _, _, eta, _ in bars)
+    assert (tmp_path / "ep.npz").is_file() and (tmp_path / "ep_truth.npz").is_file()
