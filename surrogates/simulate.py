@@ -329,6 +329,19 @@ def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, v
     return psi
 
 
+@numba.njit(cache=True, nogil=True)
+def _sensor_noise(y, e_white, white, e_col, col, gain, a, out):
+    """``out = y + e_white white + c``, with ``c`` the AR(1) coloured noise ``c[t] = e_col[t] col gain + a c[t-1]``
+    (``c[-1] = 0``) of every channel: the arithmetic of ``lfilter([1], [1, -a], e_col * col * gain, axis=0)``, in
+    one pass without temporaries."""
+    n, m = y.shape
+    state = np.zeros(m)
+    for t in range(n):
+        for c in range(m):
+            state[c] = e_col[t, c] * col[c] * gain + a * state[c]
+            out[t, c] = (y[t, c] + e_white[t, c] * white[c]) + state[c]
+
+
 # -------------------------------------------------------------------------------------------- discretised
 @dataclass(frozen=True)
 class _Discrete:
@@ -608,16 +621,14 @@ class Simulator:
         if not np.any(white) and not np.any(col):
             return y
         rng = np.random.default_rng(seed_sequence)
-        n = y.shape[0]
-        out = y + rng.standard_normal(y.shape) * white
-        if np.any(col):
-            from scipy.signal import lfilter
-
-            a = math.exp(-self.dt / max(self.model.noise.correlation_time, 1e-9))
-            e = rng.standard_normal(y.shape) * col * math.sqrt(1.0 - a * a)
-            colored = lfilter([1.0], [1.0, -a], e, axis=0)
-            out += colored
-        assert out.shape[0] == n
+        e_white = rng.standard_normal(y.shape)
+        if not np.any(col):
+            return y + e_white * white
+        a = math.exp(-self.dt / max(self.model.noise.correlation_time, 1e-9))
+        e_col = rng.standard_normal(y.shape)
+        out = np.empty(y.shape)
+        _sensor_noise(np.ascontiguousarray(y, dtype=float), e_white, np.asarray(white, dtype=float), e_col,
+                      np.asarray(col, dtype=float), math.sqrt(1.0 - a * a), a, out)
         return out
 
 
