@@ -363,7 +363,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 
     progress = None  # a bar on a terminal, once a step has run 2 s
     rep = validate(args.reference, seeds=args.seeds, duration=args.duration, runs=args.runs, plot_dir=args.plot,
-                   progress=progress)
+                   progress=progress, replay=args.replay)
     print(rep.summary(graded_only=not args.all_channels), end="")
     if args.json:
         rep.to_json(args.json)
@@ -933,7 +933,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Examples:\n"
                "  fowt-env validate                                  # the packaged OC3 Hywind runs, 8 seeds\n"
                "  fowt-env validate --seeds 2 --duration 200 --runs c_op12 b_decay   # quick look\n"
-               "  fowt-env validate ../shared/reference/openfast/runs --json fidelity.json --plot figs")
+               "  fowt-env validate ../shared/reference/openfast/runs --json fidelity.json --plot figs\n"
+               "  fowt-env validate --replay --seeds 1              # same waves and wind as OpenFAST: R² per channel")
     vd.add_argument("reference", nargs="?", default=None,
                     help="folder of OpenFAST outputs (.outb/.out/.npz/.csv/.parquet) with <run>.case.json sidecars "
                          "(default: the compact OC3 Hywind runs shipped with fowt-env)")
@@ -946,6 +947,11 @@ def build_parser() -> argparse.ArgumentParser:
     vd.add_argument("--plot", default=None, metavar="DIR", help="folder for one figure per run (PSD overlays)")
     vd.add_argument("--all-channels", action="store_true", help="list every compared channel, not only graded ones")
     vd.add_argument("--strict", action="store_true", help="exit with status 1 if a graded check fails")
+    vd.add_argument("--replay", action="store_true",
+                    help="drive the operating runs with their own measured wave elevation and wind (the inflow field "
+                         "beside each record, else Wind1VelX) instead of random seeds; adds R² per channel and band "
+                         "against OpenFAST with its linear bound (seeds then vary only the initial rotor azimuth; "
+                         "--duration is ignored)")
     vd.set_defaults(func=_cmd_validate)
 
     f = sub.add_parser("fatigue", help="damage-equivalent loads (rainflow) of a record's tower moments")

@@ -116,6 +116,10 @@ DECAY_FALLBACKS: dict[str, tuple[str, ...]] = {"TTDspFA": ("YawBrTAxp", "TwHt9AL
                                                "TTDspSS": ("YawBrTAyp", "TwHt9ALyt")}
 """Channels analysed instead of a released DOF's own channel when one of the two records lacks it."""
 
+REPLAY_SCORED_CHANNELS: tuple[str, ...] = ("PtfmSurge", "PtfmHeave", "PtfmPitch", "PtfmRoll", "PtfmYaw", "RotSpeed",
+                                           "BldPitch1", "TwrBsMyt", "TwrBsMxt", "TwHt9ALxt", "TwHt9ALyt")
+"""Channels whose replay R² ``validate(replay=True)`` reports: issue 16's list plus the side-to-side ones."""
+
 PLOT_CHANNELS: tuple[str, ...] = ("PtfmSurge", "PtfmPitch", "RotSpeed", "TwrBsMyt", "TwrBsMxt", "TwHt9ALxt")
 """Channels of the operating PSD overlay figures."""
 
@@ -702,6 +706,9 @@ class ValidationReport:
         Seeds, durations, sample time, model description, statistics method.
     figures : list of str
         Figure files written.
+    replay : list of dict
+        With ``validate(replay=True)``: per operating run, channel and band, the R² of the replayed series
+        against OpenFAST's and its linear bound (:func:`fowt_env.replay.replay_scores`).
     elapsed_s : float
         Wall-clock time of the validation (s).
     """
@@ -713,6 +720,7 @@ class ValidationReport:
     notes: list[str] = field(default_factory=list)
     settings: dict[str, Any] = field(default_factory=dict)
     figures: list[str] = field(default_factory=list)
+    replay: list[dict[str, Any]] = field(default_factory=list)
     elapsed_s: float = 0.0
 
     # ------------------------------------------------------------------ queries
@@ -746,7 +754,7 @@ class ValidationReport:
             "passed": self.passed, "n_graded": len(self.graded), "n_failed": len(self.failures),
             "settings": self.settings, "runs": self.runs, "skipped": self.skipped, "notes": self.notes,
             "decays": self.decays, "comparisons": [c.to_dict() for c in self.comparisons],
-            "figures": self.figures, "elapsed_s": self.elapsed_s,
+            "figures": self.figures, "replay": self.replay, "elapsed_s": self.elapsed_s,
         })
 
     def to_json(self, path: str | os.PathLike[str] | None = None) -> str:
@@ -825,6 +833,20 @@ class ValidationReport:
                          f"| {_mark(c)} |")
         return lines
 
+    def _replay_table(self) -> list[str]:
+        if not self.replay:
+            return []
+        bands = list(dict.fromkeys(r["band"] for r in self.replay))
+        lines = ["| run (replay) | channel | " + " | ".join(f"R² {b} (bound)" for b in bands) + " |",
+                 "|---|---|" + "---|" * len(bands)]
+        by: dict[tuple[str, str], dict[str, dict[str, Any]]] = {}
+        for r in self.replay:
+            by.setdefault((r["run"], r["channel"]), {})[r["band"]] = r
+        for (run, ch), d in by.items():
+            cells = [f"{d[b]['r2']:.2f} ({d[b]['bound']:.2f})" if b in d else "-" for b in bands]
+            lines.append(f"| {run} | {ch} | " + " | ".join(cells) + " |")
+        return lines
+
     def as_table(self, graded_only: bool = True) -> str:
         """Markdown tables: free decays, operating statistics, DELs.
 
@@ -840,7 +862,8 @@ class ValidationReport:
             reported, not graded (no tolerance for that channel, or a band holding < 1 % of OpenFAST's variance).
         """
         parts = []
-        for lines in (self._decay_table(), self._operating_table(graded_only), self._del_table()):
+        for lines in (self._decay_table(), self._operating_table(graded_only), self._del_table(),
+                      self._replay_table()):
             if lines:
                 parts.append("\n".join(lines))
         return "\n\n".join(parts)
@@ -849,9 +872,11 @@ class ValidationReport:
         """Tables plus a verdict line, the skipped runs and notes (what ``fowt-env validate`` prints)."""
         n_g, n_f = len(self.graded), len(self.failures)
         seeds = self.settings.get("seeds")
+        how = (f"{len(seeds) if isinstance(seeds, list) else seeds} surrogate seeds"
+               + (", operating runs replayed from their measured waves and wind" if self.settings.get("replay")
+                  else ""))
         lines = [f"Fidelity against OpenFAST: {n_g - n_f} of {n_g} graded checks pass "
-                 f"({len(self.runs)} runs, {len(seeds) if isinstance(seeds, list) else seeds} surrogate seeds, "
-                 f"{self.elapsed_s:.0f} s)", "", self.as_table(graded_only)]
+                 f"({len(self.runs)} runs, {how}, {self.elapsed_s:.0f} s)", "", self.as_table(graded_only)]
         for s in self.skipped:
             lines.append(f"skipped {s['run']}: {s['reason']}")
         for n in self.notes:
@@ -1238,6 +1263,34 @@ def _compare_operating(run: ReferenceRun, sims: list[Any], report: ValidationRep
                                                  None if tol is None else tol[0], "-" if tol is None else tol[1]))
 
 
+REPLAY_TRANSIENT_S = 100.0
+"""Start-up (s) of a replay discarded by ``validate(replay=True)``: the replay starts from the record's first
+sample (positions, rotor speed), not from its velocities; 100 s are about ten pitch and heave periods."""
+
+
+def _replay_operating(run: ReferenceRun, model: Any, seeds: Sequence[int], dt: float,
+                      report: ValidationReport) -> list[Any]:
+    """Replays of one operating run (one per seed: the rotor's initial azimuth), scored into ``report.replay``."""
+    from .replay import replay_record, replay_scores
+
+    inflow = Path(run.source).with_name(f"{run.name}.inflow.npz") if run.source else None
+    wind = inflow if inflow is not None and inflow.is_file() else None
+    case = _with_measured_inputs(run)
+    sims = [replay_record(run.record, case=case, wind=wind, model=model, transient=REPLAY_TRANSIENT_S, dt=dt,
+                          seed=int(s)) for s in seeds]
+    rotor_wind = None
+    if wind is not None:
+        with np.load(wind, allow_pickle=False) as z:
+            rotor_wind = (np.asarray(z["t"], float), np.asarray(z["disc_mean_u"], float))
+    else:
+        report.notes.append(f"{run.name}: no {run.name}.inflow.npz beside the record: replayed Wind1VelX (hub "
+                            f"wind, no rotor field)")
+    channels = [c for c in REPLAY_SCORED_CHANNELS if c in run.record.channels]
+    for sc in replay_scores(run.record, sims[0], rotor_wind, channels=channels):
+        report.replay.append({"run": run.name, **sc.to_dict()})
+    return sims
+
+
 def validate(
     reference: str | os.PathLike[str] | None = None,
     model: Any = None,
@@ -1250,6 +1303,7 @@ def validate(
     plot_channels: Sequence[str] = PLOT_CHANNELS,
     base_seed: int = 0,
     progress: bool | None = False,
+    replay: bool = False,
 ) -> ValidationReport:
     """Compare the surrogate with OpenFAST reference runs, channel by channel.
 
@@ -1284,6 +1338,14 @@ def validate(
     progress : bool or None
         Progress in runs with an ETA on stderr (:func:`fowt_env.progress.progress_bar`): True, False (default) or
         None (when stderr is a terminal).
+    replay : bool
+        Drive each operating run's surrogate with the run's own measured inputs instead of fresh random ones
+        (:func:`fowt_env.replay.replay_record`): its ``Wave1Elev`` and its wind -- the polar inflow field
+        ``<run>.inflow.npz`` beside the record when there is one (the packaged runs carry a 5 Hz copy), else
+        ``Wind1VelX`` -- from the record's first sample, the first ``REPLAY_TRANSIENT_S`` discarded. The seeds
+        then vary only the rotor's initial azimuth; the statistics are graded as without replay (over the
+        replay's window, against OpenFAST's over its whole window) and the report adds, per channel and band,
+        the replay's R² against OpenFAST's series with its linear bound (``report.replay``).
 
     Returns
     -------
@@ -1324,6 +1386,7 @@ def validate(
                        "std": {**_SPREAD_REL, "or": f"{_SCATTER_FACTOR:g}x the surrogate's seed-to-seed scatter "
                                                     f"where larger; bands with < 1 % of the variance not graded"},
                        "del": _DEL_REL, "decay": DECAY_TOLERANCE},
+        "replay": bool(replay),
     }
     has_initial = _simulate_supports_initial()
     figs: list[str] = []
@@ -1351,9 +1414,12 @@ def validate(
             if plot_path is not None and channel is not None:
                 figs.append(str(_plot_decay(run, sim, channel, plot_path / f"{run.name}.png")))
         else:
-            dur = run.duration if duration is None else float(duration)
-            transient = float(run.case.get("transient_s") or 60.0)
-            sims = surrogates.simulate(model, case, dur, dt, seed_list, transient=transient, noise=False)
+            if replay:
+                sims = _replay_operating(run, model, seed_list, dt, report)
+            else:
+                dur = run.duration if duration is None else float(duration)
+                transient = float(run.case.get("transient_s") or 60.0)
+                sims = surrogates.simulate(model, case, dur, dt, seed_list, transient=transient, noise=False)
             _compare_operating(run, sims, report)
             if plot_path is not None:
                 p = _plot_operating(run, sims, plot_path / f"{run.name}.png", plot_channels)

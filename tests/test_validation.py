@@ -123,7 +123,7 @@ def test_packaged_reference_round_trip():
             "c_op12_Hs2p5_Tp10", "c_op18_Hs4p0_Tp11", "d_steady12_Hs2p5_Tp10"} == set(names)
     assert [s["run"] for s in skipped] == ["a_rtest_60s"]
     size = sum(p.stat().st_size for p in V.packaged_reference_dir().iterdir())
-    assert size < 5e6
+    assert size < 6e6  # "a few MB": records 3.8 MB + the turbulent runs' 5 Hz inflow fields 1.3 MB
     op = names["c_op12_Hs2p5_Tp10"]
     assert op.kind == "operating" and op.record.fs == pytest.approx(10.0) and op.record.t[0] == pytest.approx(100.0)
     assert op.statistics is not None, "summary.json statistics do not match STATISTICS_METHOD: rerun the tool"

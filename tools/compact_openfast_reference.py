@@ -7,6 +7,10 @@ and writes to ``fowt_env/data/openfast_reference/``:
   anti-alias filtered (zero-phase polyphase FIR, ``scipy.signal.resample_poly``) and decimated from 80 Hz to
   10 Hz (operating runs and platform decays) or 20 Hz (the tower decay), values rounded to float32 precision;
 - ``<run>.case.json``: a copy of the run's conditions;
+- ``<run>.inflow.npz`` (turbulent runs that have one): the run's inflow beside its record -- hub u/v/w, disc
+  mean and the streamwise wind on the polar grid over the rotor (5 radii x 16 azimuths) -- anti-alias filtered and
+  decimated from 20 Hz to 5 Hz, the polar field stored as float16 (0.008 m/s resolution at 16 m/s), so that
+  ``fowt-env validate --replay`` can replay the measured wind field without the shared folder;
 - ``summary.json``: per run, the statistics at the **full** 80 Hz resolution (means, std in total and per band,
   DELs of the tower-base moments, free-decay periods and damping) computed by :mod:`fowt_env.validation`, so
   that the 1st tower band (0.4-0.6 Hz) and the DELs are not limited by the decimation; plus the inputs (paths,
@@ -15,6 +19,7 @@ and writes to ``fowt_env/data/openfast_reference/``:
 Usage::
 
     python tools/compact_openfast_reference.py [--source ../shared/reference/openfast/runs] [--out DIR]
+    python tools/compact_openfast_reference.py --inflow-only      # (re)write only the compact inflow files
 
 Rerun it whenever the reference runs or the statistics method (``fowt_env.validation.STATISTICS_METHOD``)
 change; ``fowt_env.validation`` recomputes the statistics from the records when the method differs.
@@ -82,14 +87,62 @@ def compact(record: Record, channels: list[str], fs_out: float, name: str, sourc
     return Record(t, yd, channels, [units[c] for c in channels], meta)
 
 
+INFLOW_FS = 5.0
+"""Sample rate (Hz) of the compact inflow files (the shared ones are at 20 Hz)."""
+
+
+def compact_inflow(path: Path, out: Path, fs_out: float = INFLOW_FS) -> Path:
+    """Write a compact copy of an OpenFAST reference ``*.inflow.npz`` (see the module docstring)."""
+    with np.load(path, allow_pickle=False) as z:
+        data = {k: z[k] for k in z.files}
+    t = np.asarray(data["t"], float)
+    fs = 1.0 / float(np.median(np.diff(t)))
+    q = int(round(fs / fs_out))
+    if q < 1 or abs(fs / q - fs_out) > 1e-6 * fs_out:
+        raise ValueError(f"{path}: {fs} Hz is not an integer multiple of {fs_out} Hz")
+
+    def dec(x: np.ndarray) -> np.ndarray:
+        return signal.resample_poly(np.asarray(x, float), 1, q, axis=0)
+
+    n = int(np.ceil(t.size / q))
+    small = {
+        "t": t[::q][:n],
+        "hub_uvw": dec(data["hub_uvw"])[:n].astype(np.float32),
+        "disc_mean_u": dec(data["disc_mean_u"])[:n].astype(np.float32),
+        "polar_u": dec(data["polar_u"])[:n].astype(np.float16),
+        "polar_radii": np.asarray(data["polar_radii"], float),
+        "polar_azimuth_rad": np.asarray(data["polar_azimuth_rad"], float),
+    }
+    for key in ("zhub", "uhub", "source"):
+        if key in data:
+            small[key] = data[key]
+    small["note"] = np.array(f"{data.get('note', '')} -- compact copy by tools/compact_openfast_reference.py: "
+                             f"anti-alias filtered and decimated to {fs_out:g} Hz, polar_u float16")
+    dest = out / path.name
+    np.savez_compressed(dest, **small)
+    return dest
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--source", type=Path, default=DEFAULT_SOURCE, help="folder of OpenFAST run folders")
     ap.add_argument("--out", type=Path, default=DEFAULT_OUT, help="output folder")
+    ap.add_argument("--inflow-only", action="store_true", help="write only the compact inflow files")
     args = ap.parse_args(argv)
     src: Path = args.source.resolve()
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
+    inflows = sorted(src.glob("*/*.inflow.npz"))
+    for path in inflows:
+        case_path = path.parent / (path.name[: -len(".inflow.npz")] + ".case.json")
+        if not case_path.is_file():
+            continue
+        duration = float(json.loads(case_path.read_text(encoding="utf-8")).get("duration_s", 0.0))
+        if duration >= validation.MIN_OPERATING_DURATION:  # the runs the package carries
+            dest = compact_inflow(path, out)
+            print(f"{dest.name}: {dest.stat().st_size / 1e6:.2f} MB")
+    if args.inflow_only:
+        return 0
     summary: dict = {
         "format": validation.SUMMARY_FORMAT, "version": 1,
         "created_by": "tools/compact_openfast_reference.py",
