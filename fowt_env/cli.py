@@ -340,7 +340,11 @@ def _cmd_discrepancy(args: argparse.Namespace) -> int:
     from . import discrepancy
 
     measured = _load_record(args.measured, args.channel_map)
-    model = surrogates.FOWTModel(_parse_effects(args.model_effects))
+    # an OpenFAST record has its tower gauges at the OC3 deck's nodes: the model measures where it does
+    openfast = "openfast" in str(measured.meta.get("source", "")).lower() or Path(args.measured).suffix.lower() in (
+        ".out", ".outb")
+    model = surrogates.FOWTModel(_parse_effects(args.model_effects),
+                                 gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS if openfast else None)
     cands = args.candidates.split(",") if args.candidates else None
     case = _record_case(measured, args.case)
     if case is None:
@@ -773,8 +777,11 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--case", default=None,
                    help="OLC number of the measured conditions (default: the record's own case, if it states one)")
     q.add_argument("--model-effects", default="all", help="candidate model: 'all', 'none' or name=strength,...")
-    q.add_argument("--candidates", default=None, help="comma-separated effects to consider (default all)")
-    q.add_argument("--seeds", type=int, default=4, help="model simulations per setting (default 4)")
+    q.add_argument("--candidates", default=None,
+                   help="comma-separated effects (surrogates.EFFECTS) and parameter multipliers "
+                        "(surrogates.parameters.PARAMETERS, e.g. tower_fa_stiffness, mooring_line_1) to consider "
+                        "(default all)")
+    q.add_argument("--seeds", type=int, default=3, help="model simulations per setting (default 3)")
     q.add_argument("--seed", type=int, default=None,
                    help="first seed of the model simulations (default 1000; the next --seeds - 1 follow)")
     q.add_argument("--json", default=None, help="write the report as JSON")
