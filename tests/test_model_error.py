@@ -10,7 +10,7 @@ import pytest
 
 import surrogates
 from fowt_env import compare as C
-from surrogates.model_error import check_perturbations, perturbed_model
+from surrogates.model_error import STANDARD_PERTURBATIONS, check_perturbations, perturbed_model
 
 NOMINAL = surrogates.FOWTModel()
 
@@ -74,3 +74,37 @@ def test_truth_effects_change_the_records_not_the_kalman_model():
     f = np.abs(np.linalg.eigvals(kf.system.A).imag) / (2 * np.pi)
     assert np.min(np.abs(f - _freq(NOMINAL, "tower_fa_1"))) < 0.005
     assert np.min(np.abs(f - np.sqrt(0.8) * _freq(NOMINAL, "tower_fa_1"))) > 0.03
+
+
+def _kalman_band_r2(truth: dict, filter_model: dict | None, seeds=(0, 1, 2)) -> np.ndarray:
+    """Median band-passed R² of the hidden channels per seed: scenario B (OLC 7) on records of ``truth``,
+    the Kalman filter on the nominal model or (``filter_model``) on a perturbed one."""
+    opts = {"kalman": {"model_perturbation": filter_model}} if filter_model else {}
+    settings = C.CompareSettings(train_cases=(1, 4, 6, 10), train_duration=200.0, duration=300.0,
+                                 truth_effects=truth, estimator_options=opts, trace_seconds=0.0)
+    res = C.compare(["B"], ["kalman"], seeds=list(seeds), settings=settings, lyapunov_time=None)
+    return np.array([r["median_r2_band"] for r in res.runs])
+
+
+@pytest.mark.slow
+def test_a_wrong_tower_stiffness_costs_the_nominal_kalman_filter_on_every_seed():
+    """EI x0.95 moves the tower modes the filter relates hidden and live gauges through: given the nominal
+    model it must do worse than given the true one, seed by seed."""
+    truth = STANDARD_PERTURBATIONS["tower stiffness x0.95"]
+    wrong, right = _kalman_band_r2(truth, None), _kalman_band_r2(truth, truth)
+    assert np.all(wrong < right), (wrong, right)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("label", [k for k in STANDARD_PERTURBATIONS if "tower" not in k])
+def test_platform_drag_mooring_and_imbalance_errors_are_below_the_seed_scatter(label):
+    """Measured (README, model-error table): with 14 of 18 gauges live every sample, the platform-level errors
+    do not resolve in scenario B -- the nominal-model filter is within 1e-4 in band-passed R² of the true-model
+    one (for platform mass and drag it is even marginally better), less than the seed-to-seed scatter. The
+    rotor imbalance's 1P load is in no linearisation: its true-model filter is the nominal one, compared here on
+    the nominal turbine's records. If a physics change makes one of these resolvable, this test says so."""
+    truth = STANDARD_PERTURBATIONS[label]
+    wrong = _kalman_band_r2(truth, None)
+    right = _kalman_band_r2({}, None) if "rotor_mass_imbalance" in truth else _kalman_band_r2(truth, truth)
+    scatter = np.ptp(right)
+    assert np.all(np.abs(wrong - right) < max(1e-4, scatter)), (wrong, right)
