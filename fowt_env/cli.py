@@ -513,7 +513,7 @@ def _demo_sensing(rec, model, case, folder: Path) -> None:
     from .progress import progress_bar
 
     t0 = time.perf_counter()
-    with progress_bar(len(others) + 2, "sensing", progress=None) as bar:
+    with progress_bar(len(others) + 3, "sensing", progress=None) as bar:
         bar.set_postfix_str("training records")
         train = []
         for c in others:
@@ -526,8 +526,11 @@ def _demo_sensing(rec, model, case, folder: Path) -> None:
         bar.set_postfix_str("fit and reconstruct")
         res = sense(rec, "dmd", hide=hidden, train=train, truth=truth)
         bar.update(1)
+        bar.set_postfix_str("figure")
+        figure = res.plot(folder, truth=truth)
+        bar.update(1)
     print(res.summary())
-    print(f"wrote {res.plot(folder, truth=truth)} ({time.perf_counter() - t0:.1f} s)")
+    print(f"wrote {figure} ({time.perf_counter() - t0:.1f} s)")
 
 
 def _demo_psd(rec, modes, case, out: Path) -> Path:
@@ -1006,6 +1009,11 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(f"fowt-env {args.command}: error: {_failure_text(exc, args)}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:  # Ctrl-C: one line, the shell's status for SIGINT
+        if args.debug:
+            raise
+        print(f"\nfowt-env {args.command}: interrupted", file=sys.stderr)
+        return 130
 
 
 def _check_output_folders(args: argparse.Namespace) -> None:

@@ -70,3 +70,15 @@ def test_out_naming_a_directory_is_a_usage_error(tmp_path, capsys, monkeypatch, 
     assert _exit_code(["simulate", "--duration", "10", "--out", name]) == 2
     assert "names a directory" in _one_line_error(capsys, "simulate")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["adir"]  # no adir.npz, no newdir.npz
+
+
+def test_ctrl_c_is_one_line_and_status_130(tmp_path, capsys, monkeypatch):
+    import surrogates
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(surrogates, "simulate", interrupted)
+    assert _exit_code(["simulate", "--duration", "10", "--out", str(tmp_path / "r.npz")]) == 130
+    err = capsys.readouterr().err
+    assert err.strip() == "fowt-env simulate: interrupted" and not list(tmp_path.iterdir())
