@@ -91,8 +91,8 @@ def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: i
 # ------------------------------------------------------------------------------------------------ kernel
 # scalar parameters of the kernel, packed in one float array ``par``
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
-    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_RQ, P_RS = range(21)
-N_PAR = 21
+    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_RQ, P_RS, P_RTY = range(22)
+N_PAR = 22
 FIELD_DT = 0.05
 """Time step (s) of the synthesised turbulent field over the rotor disc."""
 N_BLADE_AZIMUTH = 24
@@ -225,7 +225,7 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 thrust += d_t
                 q_aero += d_q
                 mt += d_t * par[P_RT] * c_b  # blade at (y, z) = r (-sin, cos): tilt = z F
-                my += d_t * par[P_RT] * s_b  # yaw = -y F
+                my += d_t * par[P_RTY] * s_b  # yaw = -y F (its own lever: see ROTOR_ASYMMETRY)
                 fy += -d_q / par[P_RQ] * c_b  # in-plane force along the direction of rotation
                 fz += -d_q / par[P_RQ] * s_b
             u[hub0 + 1] += fy
@@ -452,7 +452,7 @@ class Simulator:
         if op is not None and self.nonlinear_rotor:
             par[P_SASYM] = float(eff["rotor_asymmetry"])
             par[P_DTDU], par[P_DQDU] = op.dT_dV, op.dQ_dV
-            par[P_RT], par[P_RQ] = blade_load_radii(rt.radius)
+            par[P_RT], par[P_RQ], par[P_RTY] = blade_load_radii(rt.radius)
             par[P_RS] = BLADE_SAMPLING_RADIUS * rt.radius
         self.par = par
         self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
