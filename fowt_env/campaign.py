@@ -438,6 +438,10 @@ def _exclusive(out: Path) -> Iterator[None]:
             raise CampaignBusyError(
                 f"{out} is in use by another running campaign ({holder}); wait for it to finish or use another "
                 "directory") from None
+        except OSError as exc:  # a file system without flock (some network mounts): run, but say so
+            log.warning("cannot lock %s (%s): do not run two campaigns on it at once", out, exc.strerror or exc)
+            yield
+            return
         os.ftruncate(fd, 0)
         import socket
 
