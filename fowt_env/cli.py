@@ -358,7 +358,7 @@ def _cmd_discrepancy(args: argparse.Namespace) -> int:
         Path(args.json).write_text(json.dumps(rep.to_dict(), indent=2))
         print(f"wrote {args.json}")
     if args.plot:
-        print(f"wrote {rep.plot(Path(args.plot) / 'discrepancy.png')}")
+        print(f"wrote {_drawn(lambda: rep.plot(Path(args.plot) / 'discrepancy.png'))}")
     return 0
 
 
@@ -597,7 +597,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     rep = discrepancy.run(rec, model.without("mooring_nonlinear"), case, n_seeds=3, progress=None)
     print(rep.summary())
-    print(f"wrote {rep.plot(out / 'discrepancy.png')} ({time.perf_counter() - t0:.0f} s)")
+    print(f"wrote {_drawn(lambda: rep.plot(out / 'discrepancy.png'))} ({time.perf_counter() - t0:.0f} s)")
     return 0
 
 
@@ -616,9 +616,20 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         Path(args.json).write_text(json.dumps(res.to_dict(wall_clock=args.timings), indent=1))
         print(f"wrote {args.json}")
     if args.plot:
-        for path in res.plot(args.plot):
+        for path in _drawn(lambda: res.plot(args.plot)):
             print(f"wrote {path}")
     return 0
+
+
+def _drawn(draw):
+    """``draw()`` (figures: 10-16 s for discrepancy's or compare's on a busy machine) under a one-step bar, so the
+    wait shows its elapsed time on a terminal."""
+    from .progress import progress_bar
+
+    with progress_bar(1, "figures", progress=None) as bar:
+        out = draw()
+        bar.update(1)
+    return out
 
 
 @contextlib.contextmanager
@@ -707,7 +718,7 @@ def _cmd_campaign(args: argparse.Namespace) -> int:
         Path(args.json).write_text(json.dumps(done.to_dict(), indent=1))
         print(f"wrote {args.json}")
     if args.plot and done.result.runs:
-        for path in done.result.plot(args.plot):
+        for path in _drawn(lambda: done.result.plot(args.plot)):
             print(f"wrote {path}")
     if not done.ok:
         print(f"fowt-env campaign: {len(done.failed)} task(s) failed (listed above and in {done.summary_path}); "

@@ -206,3 +206,14 @@ def test_episode_on_a_terminal_shows_its_steps_from_the_set_up_on(tmp_path):
     assert bars and {total for _, total, _, _ in bars} == {"1599"}, out
     assert any("set-up and warm-up" in phase for *_, phase in bars) and any(eta != "?" for _, _, eta, _ in bars)
     assert (tmp_path / "ep.npz").is_file() and (tmp_path / "ep_truth.npz").is_file()
+
+
+
+def test_figures_of_discrepancy_compare_and_campaign_draw_under_a_bar(capsys, monkeypatch):
+    """The CLI's figure writing (10-16 s for discrepancy's and compare's figures on a busy machine) shows a bar."""
+    from fowt_env import cli, progress
+
+    monkeypatch.setenv(DELAY_ENV, "0")
+    monkeypatch.setattr(progress, "on_terminal", lambda stream=None: True)
+    assert cli._drawn(lambda: ["a.png", "b.png"]) == ["a.png", "b.png"]
+    assert re.search(r"figures: +\d+%\|[^|]*\| [01]/1 steps \[\d\d:\d\d elapsed, ETA", capsys.readouterr().err)
