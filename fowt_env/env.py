@@ -191,6 +191,7 @@ class SparEnv(gym.Env):
         # sensor full-scale ranges: readings saturate there, like a real sensor's (and the bounds are finite)
         self.sensor_range = np.array([SENSOR_RANGE["acc"] if "AL" in c else SENSOR_RANGE["moment"]
                                       for c in self.channels])
+        self._range_lo = -self.sensor_range
         self.observation_space = spaces.Dict(
             {
                 "sensors": spaces.Box(-self.sensor_range, self.sensor_range, shape=(n,), dtype=np.float64),
@@ -228,12 +229,21 @@ class SparEnv(gym.Env):
         return np.where(mask, y, 0.0), mask
 
     def _obs(self, y: np.ndarray, mask: np.ndarray) -> dict[str, np.ndarray]:
-        sensors = np.clip(y, -self.sensor_range, self.sensor_range).astype(np.float64, copy=False)
+        # np.clip's bounds, without its wrappers (y is finite float64: _measure zeroes what is not finite)
+        sensors = np.minimum(np.maximum(y, self._range_lo), self.sensor_range)
         return {"sensors": sensors, "mask": mask.astype(np.int8)}
 
     def _physical_action(self, action) -> tuple[np.ndarray, np.ndarray]:
         """Physical offsets ``[pitch (rad), torque (N·m)]`` and the checked normalised action (float64)."""
-        raw = np.asarray(action)
+        raw = action if isinstance(action, np.ndarray) else np.asarray(action)
+        if raw.dtype.kind == "f" and raw.shape == (2,):  # the usual float32/float64 action: no general checks
+            a = raw.astype(float)
+            a0, a1 = a.tolist()
+            if not (math.isfinite(a0) and math.isfinite(a1)):
+                raise ValueError(f"action must be finite, got {a}")
+            if abs(a0) > 1.0 + 1e-6 or abs(a1) > 1.0 + 1e-6:
+                raise ValueError(f"action must lie in [-1, 1] (normalised pitch and torque offsets), got {a}")
+            return np.array([a0 * self.max_pitch_offset, a1 * self.max_torque_offset]), a
         if np.iscomplexobj(raw):
             raise TypeError(f"action must be real [pitch, torque] in [-1, 1], got complex values: {_shown(action)}")
         try:
@@ -283,7 +293,7 @@ class SparEnv(gym.Env):
         noisy, truth = self._sim.advance(self.control_steps, act_phys, noise=self.noise)
         self._step += 1
         last = truth[-1]
-        finite = math.isfinite(float(last.sum())) and math.isfinite(float(self._sim.x.sum()))
+        finite = math.isfinite(np.add.reduce(last)) and math.isfinite(np.add.reduce(self._sim.x))
         if not finite:
             noisy = np.nan_to_num(noisy, nan=0.0, posinf=0.0, neginf=0.0)
             last = np.nan_to_num(last, nan=0.0, posinf=0.0, neginf=0.0)
