@@ -71,22 +71,24 @@ def main() -> None:
         t_full, cpu_full = best_wall_cpu(lambda: surrogates.simulate(full, case, duration=args.duration, seed=1),
                                          args.repeats)
         t_lin = best_of(lambda: surrogates.simulate(linear, case, duration=args.duration, seed=1), args.repeats)
-        t_setup = best_of(lambda: Simulator(full, case, 0.0125), args.repeats)
+        # where the time goes, in this process's CPU seconds (the wall clock of a busy machine is too noisy to
+        # split a run into parts)
+        cpu_setup = best_wall_cpu(lambda: Simulator(full, case, 0.0125), args.repeats)[1]
         sim = Simulator(full, case, 0.0125)
         n_steps = int(round(total / 0.0125))
-        t_forcing = best_of(lambda: sim.forcing(n_steps, np.random.SeedSequence(1)), args.repeats)
+        cpu_forcing = best_wall_cpu(lambda: sim.forcing(n_steps, np.random.SeedSequence(1)), args.repeats)[1]
         span = (n_steps + 1) * sim.dt_int  # what Simulator.forcing synthesises
-        t_waves = best_of(lambda: synthesize_waves(case.hs, case.tp, case.gamma, case.wave_dir_deg, span, sim.dt_int,
-                                                   seed=1, n_strips=N_STRIPS), args.repeats)
-        t_wind = best_of(lambda: synthesize_rotor_wind(case.wind_speed, case.turbulence_intensity,
-                                                       span + 2 * FIELD_DT, FIELD_DT, seed=1,
-                                                       n_azimuth=N_BLADE_AZIMUTH), args.repeats)
-    t_step = t_full - t_setup - t_forcing
+        cpu_waves = best_wall_cpu(lambda: synthesize_waves(case.hs, case.tp, case.gamma, case.wave_dir_deg, span,
+                                                           sim.dt_int, seed=1, n_strips=N_STRIPS), args.repeats)[1]
+        cpu_wind = best_wall_cpu(lambda: synthesize_rotor_wind(case.wind_speed, case.turbulence_intensity,
+                                                               span + 2 * FIELD_DT, FIELD_DT, seed=1,
+                                                               n_azimuth=N_BLADE_AZIMUTH), args.repeats)[1]
+    cpu_step = cpu_full - cpu_setup - cpu_forcing
     print(f"  full nonlinear model, 1 core : {args.duration / t_full:8.0f}x real time ({t_full:.3f} s wall; "
           f"{args.duration / cpu_full:.0f}x per second of this process's CPU time, {cpu_full:.3f} s)")
-    print(f"    set-up {t_setup:.3f} s; forcing synthesis {t_forcing:.3f} s (waves {t_waves:.3f}, rotor-plane "
-          f"wind {t_wind:.3f}, rest {t_forcing - t_waves - t_wind:.3f}); stepping, outputs and noise "
-          f"{t_step:.3f} s = {1e6 * t_step / n_steps:.2f} us/step")
+    print(f"    CPU s: set-up {cpu_setup:.3f}; forcing synthesis {cpu_forcing:.3f} (waves {cpu_waves:.3f}, "
+          f"rotor-plane wind {cpu_wind:.3f}, rest {cpu_forcing - cpu_waves - cpu_wind:.3f}); stepping, outputs and "
+          f"noise {cpu_step:.3f} = {1e6 * cpu_step / n_steps:.2f} us/step")
     print(f"  linear model,         1 core : {args.duration / t_lin:8.0f}x real time ({t_lin:.3f} s wall)")
 
     numba.set_num_threads(n_cores)
