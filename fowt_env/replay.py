@@ -167,10 +167,39 @@ def record_case(record: Any, case: Mapping[str, Any] | None = None) -> Any:
     return surrogate_case(c)
 
 
+_RATE_OF = {"PtfmSurge": "PtfmTVxi", "PtfmSway": "PtfmTVyi", "PtfmHeave": "PtfmTVzi", "PtfmRoll": "PtfmRVxi",
+            "PtfmPitch": "PtfmRVyi", "PtfmYaw": "PtfmRVzi"}
+"""The platform DOFs' rate channels (ElastoDyn names; m/s and deg/s)."""
+
+RATE_FIT_S = 2.0
+"""Window (s) of the quadratic fit that estimates a platform rate at a record's first sample."""
+
+
+def _initial_rate(t: NDArray[np.float64], x: NDArray[np.float64]) -> float | None:
+    """Rate at ``t[0]`` from a least-squares quadratic over the first ``RATE_FIT_S`` seconds (None if too short)."""
+    sel = t <= t[0] + RATE_FIT_S
+    if np.count_nonzero(sel) < 5:
+        return None
+    tt = t[sel] - t[0]
+    return float(np.polyfit(tt, x[sel], 2)[1])
+
+
 def record_initial(record: Any) -> dict[str, float]:
     """Initial conditions (OpenFAST names and units) from a record's first sample: platform DOFs, tower-top
-    deflections, rotor speed and azimuth, those the record has."""
-    return {c: float(record[c][0]) for c in _INITIAL_CHANNELS if c in record.channels}
+    deflections, rotor speed and azimuth, those the record has, and the platform DOFs' rates -- the record's
+    ``PtfmTVxi`` ... ``PtfmRVzi`` if it has them, else the slope of a quadratic fitted to the first
+    :data:`RATE_FIT_S` seconds of the position. Without the rates a replay would start the slow modes from rest:
+    the 124 s surge mode then takes minutes to forget it (OpenFAST's 18 m/s run: surge R² over 200-450 s -1.5)."""
+    out = {c: float(record[c][0]) for c in _INITIAL_CHANNELS if c in record.channels}
+    t = np.asarray(record.t, float)
+    for pos, rate in _RATE_OF.items():
+        if rate in record.channels:
+            out[rate] = float(record[rate][0])
+        elif pos in record.channels:
+            r = _initial_rate(t, np.asarray(record[pos], float))
+            if r is not None and math.isfinite(r):
+                out[rate] = r
+    return out
 
 
 def _sidecar(path: Path, suffix: str) -> Path | None:

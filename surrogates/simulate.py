@@ -68,7 +68,9 @@ MAX_SAMPLE_TIME = 0.15
 """Largest sample time (s): the 2nd tower modes (up to ~2.6 Hz) must lie below the Nyquist frequency."""
 N_EX = INPUT_BLOCKS["shear"].stop  # exogenous (precomputed) inputs: const, wave(6), wind, elev, hub wind, shear(2)
 _PLATFORM_DOF = {"PtfmSurge": 0, "PtfmSway": 1, "PtfmHeave": 2, "PtfmRoll": 3, "PtfmPitch": 4, "PtfmYaw": 5}
-_INITIAL_CHANNELS = (*_PLATFORM_DOF, "TTDspFA", "TTDspSS", "RotSpeed")
+_PLATFORM_RATE = {"PtfmTVxi": 0, "PtfmTVyi": 1, "PtfmTVzi": 2, "PtfmRVxi": 3, "PtfmRVyi": 4, "PtfmRVzi": 5}
+"""ElastoDyn's platform velocities (m/s, deg/s) as initial conditions of the platform DOFs' rates."""
+_INITIAL_CHANNELS = (*_PLATFORM_DOF, *_PLATFORM_RATE, "TTDspFA", "TTDspSS", "RotSpeed")
 
 
 def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: int) -> None:
@@ -529,7 +531,8 @@ class Simulator:
 
     def initial_state(self, initial: Mapping[str, float] | None) -> tuple[np.ndarray, np.ndarray]:
         """State and controller state to start from: the equilibrium, with ``initial`` (OpenFAST channel name ->
-        value in OpenFAST units) overriding platform DOFs, tower-top deflections and the rotor speed."""
+        value in OpenFAST units) overriding platform DOFs and their rates (``PtfmTVxi`` ... ``PtfmRVzi``), tower-top
+        deflections and the rotor speed."""
         x = self.x_eq.copy()
         ctrl = self.ctrl0.copy()
         if not initial:
@@ -541,6 +544,9 @@ class Simulator:
             if name in _PLATFORM_DOF:
                 i = _PLATFORM_DOF[name]
                 x[i] = v if i < 3 else np.deg2rad(v)
+            elif name in _PLATFORM_RATE:
+                i = _PLATFORM_RATE[name]
+                x[N_DOF + i] = v if i < 3 else np.deg2rad(v)
             elif name in ("TTDspFA", "TTDspSS"):
                 mode = 6 if name == "TTDspFA" else 8
                 axis = 0 if name == "TTDspFA" else 1
