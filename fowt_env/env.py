@@ -87,8 +87,9 @@ class SparEnv(gym.Env):
     Episode End
     -----------
     Truncation through the registration's ``max_episode_steps`` (600 s at the default dt) or
-    ``episode_seconds`` if given. Termination on physical failure: a non-finite state or platform pitch beyond
-    ``max_pitch_deg`` (default 15 deg).
+    ``episode_seconds`` if given, and with ``replay`` at the last step the measured inputs cover (a further
+    :meth:`step` raises ``gymnasium.error.ResetNeeded``). Termination on physical failure: a non-finite state or
+    platform pitch beyond ``max_pitch_deg`` (default 15 deg).
 
     Arguments
     ---------
@@ -116,6 +117,20 @@ class SparEnv(gym.Env):
         the environment is made (finite, sign, range, and the memory a sample step and warm-up imply: at most
         :data:`MAX_STEP_SAMPLES` samples per forcing chunk, warm-up or control step); a bad one raises a
         ``ValueError`` naming it. :meth:`step` before :meth:`reset` raises ``gymnasium.error.ResetNeeded``.
+    replay : path, surrogates.Record or fowt_env.replay_stream.ReplaySource, optional
+        Replay measured conditions instead of random waves and wind: every episode is driven by the record's
+        ``Wave1Elev`` and wind (:class:`fowt_env.replay_stream.ReplaySource`; a ``.npz`` record file is read
+        chunk by chunk, so a day-long episode keeps flat memory) from ``replay_start``, the warm-up included,
+        and is truncated when the inputs run out. The load case is the record's (``case.json`` beside it, else
+        estimated); a :class:`surrogates.LoadCase` given as ``case`` overrides it, a load-case number other than
+        the default is refused. ``info["replay_time"]`` is the time on the inputs' own axis (s). Use the class
+        directly (or ``gymnasium.make(..., max_episode_steps=N)``): the registration truncates at 600 s.
+    replay_wind : None, "record", path or MeasuredWind
+        The replayed wind (``ReplaySource``'s ``wind``): default an ``<run>.inflow.npz`` beside the record, else
+        its ``Wind1VelX``.
+    replay_start : float, default 0
+        Offset (s) into the inputs where each episode's warm-up starts; ``reset(options={"replay_start": s})``
+        changes it for that episode.
 
     Examples
     --------
@@ -145,6 +160,9 @@ class SparEnv(gym.Env):
         max_torque_offset: float = 4.0e5,
         max_pitch_deg: float = 15.0,
         warmup_seconds: float = 30.0,
+        replay: Any = None,
+        replay_wind: Any = None,
+        replay_start: float = 0.0,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}")
@@ -162,7 +180,21 @@ class SparEnv(gym.Env):
                 self.case = surrogates.load_case(int(case))
             except (TypeError, ValueError) as exc:
                 raise ValueError(f"case: {exc}") from exc
+        self._replay = None
+        if replay is not None:  # measured conditions: the record's load case and its forcing, chunk by chunk
+            from .replay_stream import ReplaySource
+
+            if not isinstance(case, surrogates.LoadCase) and int(case) != 7:
+                raise ValueError("case: with replay= the load case is the record's; pass a surrogates.LoadCase to "
+                                 f"override it, not the load-case number {case!r}")
+            override = case if isinstance(case, surrogates.LoadCase) else None
+            self._replay = replay if isinstance(replay, ReplaySource) else ReplaySource(
+                replay, wind=replay_wind, case=override)
+            self.case = override if override is not None else self._replay.case
         self._sim = surrogates.StreamingSimulator(self.model, self.case, dt, warmup_seconds=warmup_seconds)
+        if self._replay is not None:
+            self._sim.forcing = self._replay.forcing(self._sim.sim)
+            self.replay_start = self._replay_start(replay_start)
         self.dt = self._sim.dt
         control_dt = self.dt if control_dt is None else float(control_dt)
         ratio = control_dt / self.dt
@@ -265,6 +297,18 @@ class SparEnv(gym.Env):
         omega = truth[self._i_rpm] * np.pi / 30.0
         return float(GENERATOR_EFFICIENCY * (self._gen_torque0 + torque_offset) * omega)
 
+    def _replay_start(self, offset: object) -> float:
+        """A checked ``replay_start`` (s into the inputs): the inputs must cover the warm-up and a step from it."""
+        assert self._replay is not None
+        start = _real("replay_start", offset)
+        span = self._replay.t_end - self._replay.t_begin
+        need = (self._sim.warmup + 2) * self._sim.dt
+        if start < 0 or start + need > span:
+            raise ValueError(f"replay_start={offset!r} s: the inputs cover {span:g} s, and an episode needs the "
+                             f"warm-up and a step ({need:g} s) after its start (0 <= replay_start <= "
+                             f"{max(span - need, 0):g})")
+        return start
+
     # -------------------------------------------------------------------------------------------- Gym API
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         """Start an episode. ``options`` may hold ``faults`` (a new fault list for this and later episodes)."""
@@ -272,6 +316,12 @@ class SparEnv(gym.Env):
         if options and "faults" in options:
             self.faults = as_fault_list(options["faults"])
         seed_int = int(self.np_random.integers(0, 2**63 - 1))
+        if self._replay is not None:  # every episode replays the inputs from its start
+            start = self.replay_start if not options or "replay_start" not in options else self._replay_start(
+                options["replay_start"])
+            self._replay.restart()
+            self._sim.forcing.start(self._replay.t_begin + start)
+            self._replay_t0 = self._replay.t_begin + start + self._sim.warmup * self.dt
         self._sim.reset(np.random.SeedSequence(seed_int))
         for f in self.faults:
             f.reset(np.random.default_rng(int(self.np_random.integers(0, 2**63 - 1))), self.channels, self.dt)
@@ -280,6 +330,8 @@ class SparEnv(gym.Env):
         noisy, truth = self._sim.advance(1, np.zeros(2), noise=self.noise)
         y, mask = self._measure(noisy)
         info = {"truth": truth[-1, self._idx].copy(), "time": self._sim.time, "channels": list(self.channels)}
+        if self._replay is not None:
+            info["replay_time"] = self._replay_t0 + self._sim.time
         self._last = {"truth_all": truth[-1], "y": y, "mask": mask, "estimate": None}
         if self.render_mode == "human":
             self.render()
@@ -290,6 +342,9 @@ class SparEnv(gym.Env):
             raise gym.error.ResetNeeded("SparEnv.step() before reset(): call env.reset(seed=...) to start an "
                                         "episode first")
         act_phys, a = self._physical_action(action)
+        if self._replay is not None and self._sim.steps_left < self.control_steps * self._sim.substeps:
+            raise gym.error.ResetNeeded(f"the replayed inputs ended at t = {self._replay_t0 + self._sim.time:g} s "
+                                        "(the episode was truncated there): call env.reset()")
         noisy, truth = self._sim.advance(self.control_steps, act_phys, noise=self.noise)
         self._step += 1
         last = truth[-1]
@@ -318,6 +373,9 @@ class SparEnv(gym.Env):
             "power": power,
             "platform_pitch_deg": float(last[self._i_pitch]),
         }
+        if self._replay is not None:  # the episode ends with the measured inputs
+            truncated = truncated or self._sim.steps_left < self.control_steps * self._sim.substeps
+            info["replay_time"] = self._replay_t0 + self._sim.time
         self._last = {"truth_all": last, "y": y, "mask": mask, "estimate": self._last.get("estimate")}
         if self.render_mode == "human":
             self.render()

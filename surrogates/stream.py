@@ -12,6 +12,7 @@ AR(1) coloured with its state carried).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from scipy.signal import lfilter
@@ -39,6 +40,10 @@ class StreamingSimulator:
         Crossfade between consecutive realisations (s).
     warmup_seconds : float
         Simulated (and discarded) at every reset, from the static equilibrium.
+    forcing : callable, optional
+        Replayed forcing instead of the synthesised one: ``forcing(k0, n)`` returns ``(u_ex, vel, blade)`` at
+        internal steps ``k0 ... k0 + n`` from the reset (:class:`surrogates.replay_stream.ReplayForcing`), asked
+        for one chunk at a time without crossfade; its ``steps_available`` bounds :meth:`advance`.
 
     Examples
     --------
@@ -51,8 +56,11 @@ class StreamingSimulator:
     """
 
     def __init__(self, model: FOWTModel, case: int | LoadCase | None, dt: float = 0.0125,
-                 chunk_seconds: float = 600.0, overlap_seconds: float = 30.0, warmup_seconds: float = 30.0) -> None:
+                 chunk_seconds: float = 600.0, overlap_seconds: float = 30.0, warmup_seconds: float = 30.0,
+                 forcing: Callable[[int, int], tuple[np.ndarray, np.ndarray, np.ndarray]] | None = None) -> None:
         self.sim = Simulator(model, case, dt)
+        self.forcing = forcing
+        self._k_next = 0  # internal step (from the reset) of the next chunk of replayed forcing
         for name, value in (("chunk_seconds", chunk_seconds), ("overlap_seconds", overlap_seconds)):
             if not np.isfinite(value) or value <= 0:
                 raise ValueError(f"{name} must be positive and finite, got {value!r}")
@@ -82,6 +90,13 @@ class StreamingSimulator:
 
     def _next_chunk(self) -> None:
         """Make the next `chunk` steps of forcing (plus one sample for the hold), crossfaded with the previous."""
+        if self.forcing is not None:  # replayed inputs are continuous: the next window as it is
+            u, v, b = self.forcing(self._k_next, self.chunk)
+            self._k_next += self.chunk
+            self._u, self._vel, self._blade = (np.ascontiguousarray(a) for a in (u, v, b))
+            self._exo = self.sim.exogenous(self._u)
+            self._k = 0
+            return
         u_new, v_new, b_new = self._raw_chunk()
         if self._tail is not None:
             tail_u, tail_v, tail_b = self._tail
@@ -131,8 +146,10 @@ class StreamingSimulator:
         self._ar_state = self._col * self._noise_rng.standard_normal(len(self.channels))
         self.psi = float(np.random.default_rng(psi_seq).uniform(0.0, 2.0 * np.pi))
         self.x, self.ctrl = self.sim.initial_state(None)
+        self.psi_start = self.psi  # rad, the rotor azimuth before the warm-up
         self.time = 0.0
         self._tail = None
+        self._k_next = 0
         self._next_chunk()
         self._x_hist = np.zeros((1, N_STATE))
         self._u_hist = np.zeros((1, N_INPUT - N_EX))
@@ -168,6 +185,9 @@ class StreamingSimulator:
         """
         act = np.ascontiguousarray(action, dtype=float)
         sim = self.sim
+        if self.forcing is not None and n_samples * self.substeps > self.steps_left:
+            raise ValueError(f"the replayed inputs end {self.steps_left * sim.dt_int:g} s ahead: cannot advance "
+                             f"{n_samples * self.dt:g} s")
         # one buffer [x | exogenous u | per-step u] per output sample, so the outputs are a single product
         buf = np.empty((n_samples, self._cd.shape[1]))
         out_x = buf[:, :N_STATE]
@@ -211,3 +231,10 @@ class StreamingSimulator:
     def state(self) -> np.ndarray:
         """Current state vector (22,), a copy."""
         return self.x.copy()
+
+    @property
+    def steps_left(self) -> int:
+        """Internal steps the replayed ``forcing`` still covers (a very large number without one)."""
+        if self.forcing is None:
+            return 2**62
+        return int(self.forcing.steps_available) - (self._k_next - self.chunk + self._k)  # type: ignore[attr-defined]
