@@ -9,7 +9,9 @@ error that
 * appears, on a terminal, only once the step has run for :data:`DEFAULT_DELAY_S` seconds (2 s; the environment
   variable ``FOWT_ENV_PROGRESS_DELAY`` sets another delay, 0 = at once), so quick steps stay quiet; a bar asked
   for explicitly (``progress=True``) appears at once;
-* always shows the done/total count and the estimated time left, ``ETA mm:ss``, and is erased when the step ends.
+* always shows the done/total count and the estimated time left, ``ETA mm:ss``, and is erased when the step ends;
+* keeps its elapsed time moving every second while one unit of work runs, even inside a C call that holds the
+  GIL (a small helper process redraws it on a real terminal; elsewhere a thread does).
 
 Examples
 --------
@@ -176,25 +178,116 @@ def simulation_bar(total_s: float, desc: str = "simulate", *, progress: bool | N
 
 _BAR: type | None = None
 
+# The clock of a bar on a terminal is kept by a small helper process: a thread of this process cannot redraw
+# while a C extension holds the GIL (one scipy.linalg.eigh or svd call held it 36-66 s on the busy 2-core
+# machine, freezing the bar's elapsed time and ETA; numpy.linalg releases it). The helper hears the bar's state
+# at every draw, postfix change and (at most every 0.1 s) update, and redraws it with the time gone by whenever it
+# has heard nothing for a tick; it stops when told or when this process ends (its stdin closes).
+_CLOCK_SOURCE = r"""
+import json, os, select, signal, sys, time
+signal.signal(signal.SIGINT, signal.SIG_IGN)
+tick = float(sys.argv[1])
+state, heard, fmt, pending, done = None, time.monotonic(), None, b"", False
+out = os.fdopen(1, "w", encoding="utf-8", errors="replace")
+while not done:
+    ready, _, _ = select.select([0], [], [], tick)
+    if ready:  # read the pipe itself: a buffered reader would keep lines that select() cannot see
+        data = os.read(0, 1 << 16)
+        pending += data
+        *lines, pending = pending.split(b"\n")
+        for line in lines:
+            if line.strip() == b"stop":
+                done = True
+            elif line.strip():
+                state, heard = json.loads(line), time.monotonic()
+        done = done or not data
+        continue
+    if state is None or time.monotonic() - heard < tick:
+        continue
+    d = dict(state)
+    delay = d.pop("delay", 0.0)
+    d["elapsed"] = d["elapsed"] + time.monotonic() - heard
+    if d["elapsed"] < delay:
+        continue
+    if fmt is None:
+        from tqdm import tqdm
+        fmt = tqdm.format_meter
+    out.write("\r" + fmt(**d))
+    out.flush()
+out.close()
+"""
+
 
 def _bar_class() -> type:
-    """tqdm with a redraw thread (built on first use: importing this module does not import tqdm)."""
+    """tqdm whose elapsed time and ETA keep moving while a long unit of work runs (built on first use: importing
+    this module does not import tqdm): redrawn every ``tick_s`` seconds by a helper process on a real terminal,
+    else by a thread."""
     global _BAR
     if _BAR is not None:
         return _BAR
-    import threading
+    import json
+    import subprocess
+    import time
 
     from tqdm import tqdm
 
     class _TickingBar(tqdm):  # type: ignore[misc,valid-type]
-        """tqdm that redraws every ``tick_s`` seconds once its delay has passed (elapsed time and ETA move on
-        while a long unit of work runs)."""
+        """tqdm that redraws every ``tick_s`` seconds once its delay has passed."""
 
         def __init__(self, *args: Any, tick_s: float = 1.0, **kwargs: Any) -> None:
+            self._clock: subprocess.Popen[bytes] | None = None
+            self._sent = 0.0
             super().__init__(*args, **kwargs)
             self._stop = threading.Event()
-            if not self.disable and tick_s > 0:
+            if self.disable or tick_s <= 0:
+                return
+            fd = _terminal_fd(self.fp)
+            if fd is not None:
+                try:
+                    self._clock = subprocess.Popen([sys.executable, "-c", _CLOCK_SOURCE, str(float(tick_s))],
+                                                   stdin=subprocess.PIPE, stdout=fd, stderr=subprocess.DEVNULL,
+                                                   close_fds=True)
+                except OSError:
+                    self._clock = None
+            if self._clock is not None:
+                self._tell(force=True)
+            else:
                 threading.Thread(target=self._tick, args=(float(tick_s),), daemon=True).start()
+
+        def _tell(self, force: bool = False) -> None:
+            """Send the bar's state to the clock process (every call when forced, else at most every 0.1 s)."""
+            clock = getattr(self, "_clock", None)
+            if clock is None or clock.stdin is None:
+                return
+            now = time.monotonic()
+            if not force and now - self._sent < 0.1:
+                return
+            self._sent = now
+            state = dict(self.format_dict)
+            state["delay"] = float(self.delay or 0.0)
+            try:
+                clock.stdin.write((json.dumps(state, default=str) + "\n").encode())
+                clock.stdin.flush()
+            except (OSError, ValueError):  # the clock is gone: the bar still works, without it
+                self._clock = None
+
+        def display(self, *args: Any, **kwargs: Any) -> Any:
+            out = super().display(*args, **kwargs)
+            self._tell(force=True)
+            return out
+
+        def update(self, n: float = 1) -> Any:
+            out = super().update(n)
+            self._tell()
+            return out
+
+        def set_postfix_str(self, *args: Any, **kwargs: Any) -> None:
+            super().set_postfix_str(*args, **kwargs)
+            self._tell(force=True)
+
+        def set_postfix(self, *args: Any, **kwargs: Any) -> None:
+            super().set_postfix(*args, **kwargs)
+            self._tell(force=True)
 
         def _tick(self, tick_s: float) -> None:
             while not self._stop.wait(tick_s):
@@ -205,7 +298,30 @@ def _bar_class() -> type:
             stop = getattr(self, "_stop", None)
             if stop is not None:
                 stop.set()
+            clock = getattr(self, "_clock", None)
+            if clock is not None:
+                self._clock = None
+                try:  # told to stop, it exits without drawing again; one still starting up is simply ended
+                    if clock.stdin is not None:
+                        clock.stdin.write(b"stop\n")
+                        clock.stdin.close()
+                    clock.wait(timeout=0.5)
+                except (OSError, ValueError, subprocess.TimeoutExpired):
+                    clock.kill()
+                    clock.wait()
             super().close()
 
     _BAR = _TickingBar
     return _BAR
+
+
+def _terminal_fd(stream: Any) -> int | None:
+    """The file descriptor of ``stream`` if it is a real terminal (a helper process can write to it), else None
+    (a notebook's or a test's stand-in stream: the bar's thread draws there)."""
+    if os.name == "nt":
+        return None
+    try:
+        fd = stream.fileno()
+    except (AttributeError, ValueError, OSError):
+        return None
+    return fd if os.isatty(fd) else None

@@ -217,3 +217,18 @@ def test_figures_of_discrepancy_compare_and_campaign_draw_under_a_bar(capsys, mo
     monkeypatch.setattr(progress, "on_terminal", lambda stream=None: True)
     assert cli._drawn(lambda: ["a.png", "b.png"]) == ["a.png", "b.png"]
     assert re.search(r"figures: +\d+%\|[^|]*\| [01]/1 steps \[\d\d:\d\d elapsed, ETA", capsys.readouterr().err)
+
+
+
+def test_the_clock_moves_while_a_c_call_holds_the_gil(tmp_path):
+    """A thread cannot redraw while one C call holds the GIL (scipy.linalg.eigh/svd held it 36-66 s on the busy
+    machine); the bar's helper process can. Here libc's sleep(4) through ctypes.PyDLL, which keeps the GIL."""
+    script = tmp_path / "held.py"
+    script.write_text("import ctypes\nfrom fowt_env.progress import progress_bar\n"
+                      "with progress_bar(1, 'held', progress=True) as bar:\n"
+                      "    ctypes.PyDLL(None).sleep(4)\n"
+                      "    bar.update(1)\n")
+    code, out = _run_on_a_terminal([sys.executable, str(script)])
+    assert code == 0, out
+    elapsed = set(re.findall(r"held: +0%\|[^|]*\| 0/1 steps \[(\d\d:\d\d) elapsed", out))
+    assert {"00:02", "00:03"} & elapsed, out  # redrawn during the call, not only before and after it
