@@ -52,7 +52,7 @@ class StreamingSimulator:
     >>> y0 = sim.reset(seed=1)
     >>> noisy, truth = sim.advance(80, action=np.zeros(2))
     >>> truth.shape
-    (80, 45)
+    (80, 55)
     """
 
     def __init__(self, model: FOWTModel, case: int | LoadCase | None, dt: float = 0.0125,
@@ -137,7 +137,7 @@ class StreamingSimulator:
 
         Returns
         -------
-        ndarray (45,)
+        ndarray (55,)
             Noise-free channel values at the first sample after the warm-up.
         """
         self._seq = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
@@ -159,7 +159,7 @@ class StreamingSimulator:
         return self.output()
 
     def output(self) -> np.ndarray:
-        """Noise-free channel values at the current state (45,), with zero actions and current forcing."""
+        """Noise-free channel values at the current state (55,), with zero actions and current forcing."""
         x_hist = np.zeros((1, N_STATE))
         u_hist = np.zeros((1, N_INPUT - N_EX))
         self.sim.advance(self.x.copy(), self.ctrl.copy(), self.psi, self._k, 1, 1, self._exo, self._u, np.zeros(2),
@@ -180,7 +180,7 @@ class StreamingSimulator:
 
         Returns
         -------
-        noisy, truth : ndarray (n_samples, 45)
+        noisy, truth : ndarray (n_samples, 55)
             Channel values at the start of each sample interval.
         """
         act = np.ascontiguousarray(action, dtype=float)
