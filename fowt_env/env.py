@@ -191,10 +191,10 @@ class SparEnv(gym.Env):
             self._replay = replay if isinstance(replay, ReplaySource) else ReplaySource(
                 replay, wind=replay_wind, case=override)
             self.case = override if override is not None else self._replay.case
+            self.replay_start = self._replay_start(replay_start, (round(warmup_seconds / dt) + 2) * dt)
         self._sim = surrogates.StreamingSimulator(self.model, self.case, dt, warmup_seconds=warmup_seconds)
         if self._replay is not None:
             self._sim.forcing = self._replay.forcing(self._sim.sim)
-            self.replay_start = self._replay_start(replay_start)
         self.dt = self._sim.dt
         control_dt = self.dt if control_dt is None else float(control_dt)
         ratio = control_dt / self.dt
@@ -297,12 +297,13 @@ class SparEnv(gym.Env):
         omega = truth[self._i_rpm] * np.pi / 30.0
         return float(GENERATOR_EFFICIENCY * (self._gen_torque0 + torque_offset) * omega)
 
-    def _replay_start(self, offset: object) -> float:
-        """A checked ``replay_start`` (s into the inputs): the inputs must cover the warm-up and a step from it."""
+    def _replay_start(self, offset: object, need: float | None = None) -> float:
+        """A checked ``replay_start`` (s into the inputs): the inputs must cover the warm-up and a step from it
+        (``need`` s, default the simulator's warm-up and two samples)."""
         assert self._replay is not None
         start = _real("replay_start", offset)
         span = self._replay.t_end - self._replay.t_begin
-        need = (self._sim.warmup + 2) * self._sim.dt
+        need = (self._sim.warmup + 2) * self._sim.dt if need is None else need
         if start < 0 or start + need > span:
             raise ValueError(f"replay_start={offset!r} s: the inputs cover {span:g} s, and an episode needs the "
                              f"warm-up and a step ({need:g} s) after its start (0 <= replay_start <= "

@@ -263,17 +263,18 @@ def _column_pass(series: MeasuredSeries, column: int, m: int, block: int = 1 << 
 
 
 def _segment_filter(x: np.ndarray, mean: float, dt: float, taper_s: float, transfer, up: int,
-                    band: tuple[float, float] | None, cache: dict, dc_ref: float) -> np.ndarray:
+                    band: tuple[float, float] | None, cache: dict, dc_ref: float, n_min: int = 0) -> np.ndarray:
     """:func:`surrogates.replay._fft_filter` on one segment, about the record's ``mean`` (not the segment's).
 
     Returns ``(n * up, n_out)`` on the grid ``dt / up`` from the segment's first sample. ``transfer(f)`` is
     evaluated once per FFT length (``cache``). ``dc_ref`` (:func:`whole_record_dc`) replaces the segment's
-    zero-frequency artefact by the whole record's."""
+    zero-frequency artefact by the whole record's. The FFT is at least as long as for ``n_min`` samples, so that
+    the windows of one chunk size, clipped or not, share one FFT length (and one evaluation of ``transfer``)."""
     n = x.size
     m = _taper_samples(n, dt, taper_s)
     ext = _extend_about(x, mean, max(m, 0))
     m = max(m, 0)
-    n_fft = _n_fft(n, m, dt)
+    n_fft = _n_fft(max(n, n_min), m, dt)
     key = (n_fft, up)
     if key not in cache:
         f = np.fft.rfftfreq(n_fft, dt)
@@ -383,7 +384,12 @@ class ReplayForcing:
         i_b = int(math.ceil((t_b - series.t0) / series.dt - 1e-9)) + 1 + m
         return max(0, i_a), min(series.n_samples, i_b)
 
-    def _wave_series(self, t: np.ndarray, block: np.ndarray, s0: int) -> np.ndarray:
+    @staticmethod
+    def _window_rows(series: MeasuredSeries, n_steps: int, dt_int: float, margin_s: float) -> int:
+        """Rows of an unclipped window of ``n_steps`` internal steps (the FFT length of every window)."""
+        return int(math.ceil(n_steps * dt_int / series.dt)) + 3 + 2 * int(math.ceil(margin_s / series.dt))
+
+    def _wave_series(self, t: np.ndarray, block: np.ndarray, s0: int, n_min: int) -> np.ndarray:
         """Elevation, the three along-wave loads and the strip velocities at ``t`` from rows ``s0...`` of the
         elevation (``(len(t), 4 + n_strips)``)."""
         wv = self.waves
@@ -395,14 +401,14 @@ class ReplayForcing:
             return _wave_transfer_rows(f, WATER_DEPTH, geo, z)
 
         fine = _segment_filter(block, self.wave_mean, dt, wv.taper_s, transfer, up, (wv.f_min_hz, self.f_max_hz),
-                               self._cache_waves, self.wave_dc)
+                               self._cache_waves, self.wave_dc, n_min)
         t_fine = wv.series.t0 + np.arange(s0 * up, s0 * up + fine.shape[0]) * (dt / up)
         out = np.empty((t.size, fine.shape[1]))
         for j in range(fine.shape[1]):
             out[:, j] = np.interp(t, t_fine, fine[:, j])
         return out
 
-    def _wind_series(self, t: np.ndarray, block: np.ndarray, s0: int) -> tuple[np.ndarray, ...]:
+    def _wind_series(self, t: np.ndarray, block: np.ndarray, s0: int, n_min: int) -> tuple[np.ndarray, ...]:
         """Hub wind, rotor-effective wind, shear (y, z, or None) and blade winds (or None) at ``t``."""
         wd = self.wind
         dt = wd.series.dt
@@ -415,7 +421,8 @@ class ReplayForcing:
             def transfer(f: np.ndarray) -> np.ndarray:
                 return rotor_averaging(f, v, wd.radius, wd.hub_height)[1][None, :].astype(complex)
 
-            eff = _segment_filter(hub, v, dt, wd.taper_s, transfer, 1, None, self._cache_wind, self.wind_dc)[:, 0]
+            eff = _segment_filter(hub, v, dt, wd.taper_s, transfer, 1, None, self._cache_wind, self.wind_dc,
+                                  n_min)[:, 0]
             eff = eff + v * _profile_disc_mean(wd.shear_exponent, wd.hub_height, wd.radius)
         elif wd.level == "rotor_effective":
             eff = block[:, wd.effective_column]
@@ -475,7 +482,8 @@ class ReplayForcing:
             block_w, block_v = both[ra[0] - lo: ra[1] - lo], both[rb[0] - lo: rb[1] - lo]
         else:
             block_w, block_v = wv.series.read(*ra), wd.series.read(*rb)
-        series = self._wave_series(t, np.ascontiguousarray(block_w[:, wv.column]), ra[0])
+        series = self._wave_series(t, np.ascontiguousarray(block_w[:, wv.column]), ra[0],
+                                   self._window_rows(wv.series, n_steps, sim.dt_int, wv.margin_s))
         beta = np.deg2rad(wv.direction_deg if wv.direction_deg is not None else lc.wave_dir_deg)
         cb, sb = np.cos(beta), np.sin(beta)
         u_ex = np.zeros((n, N_EX))
@@ -490,7 +498,8 @@ class ReplayForcing:
         vel[:n_in] = series[:, 4:, None] * np.array([cb, sb])
         u_ex[:n_in, INPUT_BLOCKS["wave"]] = excitation + sim.drag.excitation(vel[:n_in])
         u_ex[:n_in, INPUT_BLOCKS["elev"].start] = series[:, 0]
-        hub, eff, shy, shz, blade_in = self._wind_series(t, block_v, rb[0])
+        hub, eff, shy, shz, blade_in = self._wind_series(
+            t, block_v, rb[0], self._window_rows(wd.series, n_steps, sim.dt_int, margin_wind))
         u_ex[:n_in, INPUT_BLOCKS["wind"].start] = eff - lc.wind_speed
         u_ex[:n_in, INPUT_BLOCKS["hub_wind"].start] = hub
         i_sh = INPUT_BLOCKS["shear"].start

@@ -35,16 +35,21 @@ def record_file(tmp_path_factory):
     return rec, path
 
 
-def test_chunked_forcing_matches_the_whole_record_transform_across_seams():
-    rec = _measured(400.0)
-    lc = record_case(rec)
-    sim = surrogates.Simulator(surrogates.FOWTModel(), lc, 0.0125)
+@pytest.fixture(scope="module")
+def replay_env(record_file):
+    _, path = record_file
+    return SparEnv(replay=path, dt=0.05, noise=False, warmup_seconds=20.0, plane="FA")
+
+
+def test_chunked_forcing_matches_the_whole_record_transform_across_seams(record_file, replay_env):
+    rec, _ = record_file
+    sim = replay_env._sim.sim  # the record's load case, dt 0.05 s
     n_steps = int(390.0 / sim.dt_int)
     u_w, v_w, _, _ = replay_forcing(sim, n_steps, 0.0, MeasuredWaves.from_record(rec), MeasuredWind.from_record(rec),
                                     np.random.SeedSequence(0))
     series = ArraySeries(0.0, DT_REC, np.column_stack([rec["Wave1Elev"], rec["Wind1VelX"]]))
     forcing = ReplayForcing(sim, StreamedWaves(series, 0), StreamedWind(series, "hub", hub_column=1))
-    chunk = int(100.0 / sim.dt_int)  # four seams
+    chunk = int(80.0 / sim.dt_int)  # four seams
     parts_u, parts_v = [], []
     for k0 in range(0, n_steps, chunk):
         u, v, blade = forcing(k0, chunk)
@@ -63,6 +68,7 @@ def test_chunked_forcing_matches_the_whole_record_transform_across_seams():
     assert np.max(np.abs(v_c[..., 0] - v_w[..., 0]) / scale) < SEAM_TOLERANCE  # the deep strips included
 
 
+@pytest.mark.slow
 def test_streaming_simulator_replay_equals_simulate_through_chunk_seams():
     rec = _measured(400.0)
     lc = record_case(rec)
@@ -78,9 +84,9 @@ def test_streaming_simulator_replay_equals_simulate_through_chunk_seams():
         assert np.max(np.abs(truth[:, i] - ref.y[:, i])) < 1e-3 * np.std(ref.y[:, i]), ch
 
 
-def test_replayed_episode_reproduces_simulate_on_the_same_file(record_file):
-    rec, path = record_file
-    env = SparEnv(replay=path, dt=0.05, noise=False, warmup_seconds=20.0, plane="FA")
+def test_replayed_episode_reproduces_simulate_on_the_same_file(record_file, replay_env):
+    rec, _ = record_file
+    env = replay_env
     assert env.case == record_case(rec)
     obs, info = env.reset(seed=2)
     assert info["replay_time"] == pytest.approx(20.05)
@@ -96,27 +102,30 @@ def test_replayed_episode_reproduces_simulate_on_the_same_file(record_file):
     assert np.max(np.abs(got - want) / want.std(axis=0)) < 1e-4
 
 
-def test_the_episode_ends_with_the_inputs_and_restarts_from_replay_start(record_file):
-    _, path = record_file
-    env = SparEnv(replay=path, noise=False, warmup_seconds=10.0, control_dt=2.0, replay_start=250.0)
-    obs0, info = env.reset(seed=0)
-    assert info["replay_time"] == pytest.approx(260.0125)
+def test_the_episode_ends_with_the_inputs_and_restarts_from_replay_start(replay_env):
+    env = replay_env
+    obs0, info = env.reset(seed=0, options={"replay_start": 250.0})
+    assert info["replay_time"] == pytest.approx(270.05)
     steps = 0
     truncated = False
     while not truncated:
         _, _, terminated, truncated, info = env.step(np.zeros(2))
         steps += 1
         assert not terminated
-    assert steps == 69  # 399.95 - 260 s of inputs left: 69 whole 2 s steps, the 70th would need 400.01 s
-    assert 399.95 - 2.0 < info["replay_time"] <= 399.95
+    # 399.95 s is the last input sample; the hold of the last internal step needs it
+    assert 399.95 - 0.05 < info["replay_time"] <= 399.95 + 1e-9
+    assert steps == round((info["replay_time"] - 270.05) / 0.05)
     with pytest.raises(gym.error.ResetNeeded, match="replayed inputs ended"):
         env.step(np.zeros(2))
-    obs1, _ = env.reset(seed=0)
+    obs1, _ = env.reset(seed=0, options={"replay_start": 250.0})
     np.testing.assert_array_equal(obs0["sensors"], obs1["sensors"])
-    _, info = env.reset(seed=0, options={"replay_start": 0.0})
-    assert info["replay_time"] == pytest.approx(10.0125)
+    _, info = env.reset(seed=0)
+    assert info["replay_time"] == pytest.approx(20.05)
+    with pytest.raises(ValueError, match="replay_start=-1"):
+        env.reset(options={"replay_start": -1.0})
 
 
+@pytest.mark.slow
 def test_a_record_in_memory_and_an_explicit_load_case(record_file):
     rec, _ = record_file
     lc = surrogates.load_case(7).replace(hs=4.0, tp=9.0, wind_speed=12.0, name="mine")
@@ -124,8 +133,7 @@ def test_a_record_in_memory_and_an_explicit_load_case(record_file):
     assert env.case is lc
     env.reset(seed=0)
     env.step(np.zeros(2))
-    with pytest.raises(ValueError, match="load case is the record's"):
-        SparEnv(replay=rec, case=3)
+
 
 
 def test_npz_series_reads_windows_forward_and_back(record_file):
@@ -174,14 +182,13 @@ def test_bad_inputs_get_clear_errors(tmp_path, where):
 
 
 def test_bad_replay_arguments(record_file, tmp_path):
-    _, path = record_file
+    rec, path = record_file
     with pytest.raises(ValueError, match="replay_start=390"):
         SparEnv(replay=path, replay_start=390.0)
     with pytest.raises(ValueError, match="replay_start must be finite"):
         SparEnv(replay=path, replay_start=float("nan"))
-    env = SparEnv(replay=path)
-    with pytest.raises(ValueError, match="replay_start=-1"):
-        env.reset(options={"replay_start": -1.0})
+    with pytest.raises(ValueError, match="load case is the record's"):
+        SparEnv(replay=rec, case=3)
     with pytest.raises(ValueError, match="replay must be a record file path"):
         SparEnv(replay=42)
     with pytest.raises(ValueError, match="is not a file"):
@@ -194,6 +201,7 @@ def test_bad_replay_arguments(record_file, tmp_path):
         SparEnv(replay=other)
 
 
+@pytest.mark.slow
 def test_a_polar_inflow_file_is_streamed_as_the_field_wind(record_file, tmp_path):
     rec, path = record_file
     t = np.arange(0.0, 400.0, 0.2)
