@@ -664,6 +664,7 @@ def _scheduler(spec: str | None, desc: str, total: int | None = None, security: 
 def _compare_request(args: argparse.Namespace) -> tuple[list[str], list[str], dict]:
     """The grid and settings of the compare/campaign arguments: (scenarios, estimators, keyword arguments)."""
     from .compare import SCENARIO_NAMES, SWEEP_INTERVALS, CompareSettings, parse_int_list
+    from .io import load_channel_map
 
     def floats(text: str, name: str) -> list[float]:
         try:
@@ -688,6 +689,7 @@ def _compare_request(args: argparse.Namespace) -> tuple[list[str], list[str], di
         train_seed=args.train_seed, duration=args.duration, plane=None if args.plane == "all" else args.plane,
         dropout_rate=args.dropout_rate, dropout_burst_s=args.dropout_burst, estimator_options=options,
         train_files=tuple(args.train or ()), test_files=tuple(args.test or ()),
+        channel_map=load_channel_map(args.channel_map) if args.channel_map else {},
         band=tuple(floats(args.band, "band")),  # type: ignore[arg-type]
         truth_effects={k: _option_value(v) for k, _, v in (item.strip().partition("=") for item in
                                                           (args.truth_model or "").split(",") if item.strip())})
@@ -896,6 +898,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "with --test (then --cases are test-file indices; kalman is linearised at each test record's "
                         "operating point: its .case.json sidecar, metadata or mean Wind1VelX)")
     c.add_argument("--test", nargs="+", default=None, metavar="FILE", help="test on these records (with --train)")
+    c.add_argument("--channel-map", default=None, metavar="FILE.json",
+                   help="with --train/--test: rename file columns to channel names ({\"column\": \"TwHt1ALxt\", ...})")
     c.add_argument("--band", default="0.25,5", metavar="LO,HI",
                    help="band (Hz) of the band-passed scores, below the records' Nyquist frequency (default 0.25,5)")
     c.add_argument("--truth-model", default=None, metavar="NAME=VALUE,...",

@@ -298,6 +298,9 @@ class CompareSettings:
         ``train_cases``/``train_seed``/``duration`` are unused. Model-based sensors (``kalman``) are linearised at
         each test record's operating point: its ``<name>.case.json`` sidecar, else its metadata's ``case``, else
         the mean of ``Wind1VelX`` (and 4 std / the spectral peak of ``Wave1Elev``).
+    channel_map : dict
+        Records from files: file column name -> fowt-env channel name, for every format
+        (:func:`fowt_env.io.load_record`'s ``channel_map``), e.g. a CSV whose columns are not OpenFAST's names.
     truth_effects : dict
         Surrogate records only: the training and test records come from
         :func:`surrogates.model_error.perturbed_model` with these perturbations (e.g. ``{"tower_stiffness":
@@ -318,6 +321,7 @@ class CompareSettings:
     train_files: tuple[str, ...] = ()
     test_files: tuple[str, ...] = ()
     truth_effects: dict[str, float] = field(default_factory=dict)
+    channel_map: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         import surrogates
@@ -330,6 +334,10 @@ class CompareSettings:
         if bool(self.train_files) != bool(self.test_files):
             raise ValueError("train_files and test_files must be given together (records from files), or neither")
         object.__setattr__(self, "truth_effects", check_perturbations(self.truth_effects))
+        cmap = self.channel_map or {}
+        if not (isinstance(cmap, dict) and all(isinstance(k, str) and isinstance(v, str) for k, v in cmap.items())):
+            raise ValueError(f"channel_map must map file column names to channel names (str -> str), got {cmap!r}")
+        object.__setattr__(self, "channel_map", dict(cmap))
         if self.files and self.truth_effects:
             raise ValueError("truth_effects perturbs simulated records; records from files are their own truth")
         if self.files:
@@ -375,7 +383,7 @@ class CompareSettings:
         from surrogates.channels import ALL_CHANNELS, tower_channels
 
         wanted = tower_channels(self.plane) if self.plane is not None else list(ALL_CHANNELS[:36])
-        recs = [_file_record(f) for f in self.train_files + self.test_files]
+        recs = [_file_record(f, self.channel_map) for f in self.train_files + self.test_files]
         dts = sorted({r.dt for r in recs})
         if dts[-1] - dts[0] > 1e-9 * dts[0]:
             listing = ", ".join(f"{r.name}: {r.dt:g} s" for r in recs)
@@ -531,23 +539,25 @@ _FILES = _Memo(16)
 _OPERATING_KEYS = ("wind_speed", "hs", "tp", "gamma", "wave_dir_deg", "turbulence_intensity")
 
 
-def _file_record(path: str) -> _FileRecord:
-    """Read a record file once per process (keyed by path, size and modification time)."""
+def _file_record(path: str, channel_map: dict[str, str] | None = None) -> _FileRecord:
+    """Read a record file once per process (keyed by path, size, modification time and channel map)."""
     p = Path(path)
+    cmap = dict(channel_map or {})
     try:
         st = p.stat()
-        key = json.dumps([str(p.resolve()), st.st_size, st.st_mtime_ns])
+        key = json.dumps([str(p.resolve()), st.st_size, st.st_mtime_ns, cmap], sort_keys=True)
     except OSError:
-        key = json.dumps([str(p), None, None])  # load_record says what is wrong
-    return _FILES.get(key, lambda: _read_file_record(p))
+        key = json.dumps([str(p), None, None, cmap], sort_keys=True)  # load_record says what is wrong
+    return _FILES.get(key, lambda: _read_file_record(p, cmap))
 
 
-def _read_file_record(p: Path) -> _FileRecord:
+def _read_file_record(p: Path, channel_map: dict[str, str]) -> _FileRecord:
     from surrogates.channels import ALL_CHANNELS
 
     from .io import load_record
 
-    rec = load_record(p, unknown_channels="keep") if p.suffix.lower() in (".csv", ".parquet") else load_record(p)
+    table = p.suffix.lower() in (".csv", ".parquet")
+    rec = load_record(p, channel_map=channel_map or None, **({"unknown_channels": "keep"} if table else {}))
     if rec.y.shape[0] < 10:
         raise ValueError(f"{p}: a record of {rec.y.shape[0]} samples is too short to test on")
     tower = [c for c in ALL_CHANNELS[:36] if c in rec.channels]
@@ -622,12 +632,12 @@ def training_data(settings: CompareSettings) -> list[np.ndarray]:
                 for c in settings.train_cases]
 
     key = settings._key("train_cases", "train_duration", "train_seed", "dt", "plane", "train_files",
-                        "truth_effects")
+                        "truth_effects", "channel_map")
     return [a.copy() for a in _TRAIN_DATA.get(key, compute)]
 
 
 def _file_columns(path: str, settings: CompareSettings) -> np.ndarray:
-    rec = _file_record(path)
+    rec = _file_record(path, settings.channel_map)
     return np.ascontiguousarray(rec.y[:, [rec.channels.index(c) for c in settings.channels]])
 
 
@@ -644,7 +654,7 @@ def held_out_data(case: int, seed: int, settings: CompareSettings) -> tuple[np.n
         return _select(noisy, settings), _select(truth, settings)
 
     key = json.dumps([int(case), 0 if settings.files else int(seed),
-                      settings._key("duration", "dt", "plane", "test_files", "truth_effects")])
+                      settings._key("duration", "dt", "plane", "test_files", "truth_effects", "channel_map")])
     noisy, truth = _TEST_DATA.get(key, compute)
     return noisy.copy(), truth.copy()
 
@@ -657,7 +667,7 @@ def _operating_options(estimator: str, settings: CompareSettings, case: int | No
         return {}
     if "linearization_case" in settings.estimator_options.get(estimator, {}):
         return {}
-    rec = _file_record(settings.test_files[0 if case is None else int(case)])
+    rec = _file_record(settings.test_files[0 if case is None else int(case)], settings.channel_map)
     if rec.operating is None:
         raise ValueError(f"estimator {estimator!r} needs the operating point of test record {rec.name}: "
                          f"{rec.operating_source}; give it, e.g. {estimator}.linearization_case=7 (an OLC)")
@@ -698,7 +708,7 @@ def _fitted(estimator: str, update_interval: float | None, settings: CompareSett
 
     key = json.dumps([estimator, fit_interval, extra,
                       settings._key("train_cases", "train_duration", "train_seed", "dt", "plane", "estimator_options",
-                                    "train_files", "truth_effects")], default=str)
+                                    "train_files", "truth_effects", "channel_map")], default=str)
     sensor, fit_s = _SENSORS.get(key, compute)
     sensor = copy.deepcopy(sensor)
     if fit_interval != interval:
@@ -951,7 +961,7 @@ def run_unit(case: int, seed: int, scenario: str, estimator: str, update_interva
         "lost_fraction": float(hidden.mean()), "channels": rows, **_aggregate(rows),
     }
     if settings.files:
-        rec = _file_record(settings.test_files[int(case)])
+        rec = _file_record(settings.test_files[int(case)], settings.channel_map)
         out["operating_point"] = {"wind_speed": (rec.operating or {}).get("wind_speed"),
                                   "source": rec.operating_source}
     out["trace"] = _trace(truth, est, hidden, rows, settings)
@@ -1167,7 +1177,7 @@ class CompareResult:
                      f"R2/NRMSE on the hidden channels (physical; band = "
                      f"{s.band[0]:g}-{s.band[1]:g} Hz band-passed); the test records are their own truth"]
             for i, f in enumerate(s.test_files):
-                rec = _file_record(f)
+                rec = _file_record(f, s.channel_map)
                 op = rec.operating
                 where = f"{op['wind_speed']:.2f} m/s from the {rec.operating_source}" if op else rec.operating_source
                 lines.append(f"  test {i} = {Path(f).name} (operating point: {where})")

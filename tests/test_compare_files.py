@@ -124,3 +124,22 @@ def test_openfast_80hz_records_dmd_beats_hold_on_the_tower_band():
     dmd = next(r for r in res.runs if r["estimator"] == "dmd")
     assert hold["median_r2_band"] == pytest.approx(0.0, abs=0.05)
     assert dmd["median_r2_band"] > 0.5 and dmd["median_r2"] > hold["median_r2"] + 0.3
+
+
+def test_a_channel_map_reads_tables_with_other_column_names(tmp_path, files_result):
+    from fowt_env.io import load_record, rename_channels, save_record
+
+    ours = {"TwHt1ALxt": "acc_base", "TwHt9ALxt": "acc_top", "TwHt1MLyt": "mom_base", "TwHt9MLyt": "mom_top",
+            "TwHt5ALxt": "acc_mid", "TwHt5MLyt": "mom_mid"}
+    paths = []
+    for src in (TRAIN[0], TEST[0]):
+        rec = load_record(src)
+        rec = rec.select([*ours, "Wind1VelX"])
+        paths.append(save_record(rename_channels(rec, ours), tmp_path / (Path(src).stem + ".csv")))
+    settings = C.CompareSettings(train_files=(str(paths[0]),), test_files=(str(paths[1]),), band=BAND,
+                                 channel_map={v: k for k, v in ours.items()}, trace_seconds=0.0)
+    res = C.compare(["B"], ["hold"], settings=settings, lyapunov_time=None)
+    ref = next(r for r in files_result.runs if r["scenario"] == "B")
+    assert res.runs[0]["hidden"] == ref["hidden"]
+    for a, b in zip(res.runs[0]["channels"], ref["channels"], strict=True):  # float32 npz vs CSV text
+        assert a["r2"] == pytest.approx(b["r2"], abs=1e-6)
