@@ -160,6 +160,7 @@ def test_simulate_on_a_terminal_shows_simulated_seconds_and_an_eta(tmp_path):
     assert "wrote " in out and (tmp_path / "r.npz").is_file()
 
 
+@pytest.mark.slow  # the class is covered by the default identify tests; ~10-17 s of subprocess
 def test_simulate_piped_has_no_progress(tmp_path):
     proc = subprocess.run(_simulate_argv(tmp_path / "r.npz"), capture_output=True, text=True, env=_env(), timeout=300,
                           stdin=subprocess.DEVNULL)
@@ -186,6 +187,7 @@ def test_simulate_replay_on_a_terminal_shows_the_records_seconds(tmp_path):
 
 
 
+@pytest.mark.slow  # the class is covered by the default identify tests; ~10-17 s of subprocess
 def test_identify_plot_on_a_terminal_counts_its_figures(record, tmp_path):
     """The figures (13.8 s for four on a busy 2-core machine, 600 s record) have their own bar."""
     code, out = _run_on_a_terminal([*_identify_argv(record), "--no-ssi", "--rotor-speed", "none", "--plot",
