@@ -186,7 +186,6 @@ def test_simulate_replay_on_a_terminal_shows_the_records_seconds(tmp_path):
     assert any(n == total for n, total, _ in bars) and any(eta != "?" for *_, eta in bars)
 
 
-
 @pytest.mark.slow  # the class is covered by the default identify tests; ~10-17 s of subprocess
 def test_identify_plot_on_a_terminal_counts_its_figures(record, tmp_path):
     """The figures (13.8 s for four on a busy 2-core machine, 600 s record) have their own bar."""
@@ -210,7 +209,6 @@ def test_episode_on_a_terminal_shows_its_steps_from_the_set_up_on(tmp_path):
     assert (tmp_path / "ep.npz").is_file() and (tmp_path / "ep_truth.npz").is_file()
 
 
-
 def test_figures_of_discrepancy_compare_and_campaign_draw_under_a_bar(capsys, monkeypatch):
     """The CLI's figure writing (10-16 s for discrepancy's and compare's figures on a busy machine) shows a bar."""
     from fowt_env import cli, progress
@@ -219,7 +217,6 @@ def test_figures_of_discrepancy_compare_and_campaign_draw_under_a_bar(capsys, mo
     monkeypatch.setattr(progress, "on_terminal", lambda stream=None: True)
     assert cli._drawn(lambda: ["a.png", "b.png"]) == ["a.png", "b.png"]
     assert re.search(r"figures: +\d+%\|[^|]*\| [01]/1 steps \[\d\d:\d\d elapsed, ETA", capsys.readouterr().err)
-
 
 
 def test_the_clock_moves_while_a_c_call_holds_the_gil(tmp_path):
