@@ -27,6 +27,13 @@ memoised per process (:func:`clear_cache`); a unit works on its own deep copy of
 
 Estimators are looked up by name in :data:`ESTIMATORS` (extensible, see :func:`register_estimator`).
 
+Data this project did not make (issue 17): ``CompareSettings(train_files=..., test_files=...)`` (``fowt-env compare
+--train FILE... --test FILE...``) trains and tests on records from files -- OpenFAST ``.out``/``.outb``, CSV/Parquet
+(with ``channel_map``), ``.npz`` -- and ``kalman`` is then linearised at each test record's operating point (its
+``case.json`` sidecar, metadata, or mean ``Wind1VelX``): a mismatched model, as on a real turbine.
+``CompareSettings(truth_effects=...)`` (``--truth-model``) makes the simulated records come from a perturbed
+surrogate (:func:`surrogates.model_error.perturbed_model`) while ``kalman`` keeps the nominal model.
+
 Examples
 --------
 >>> from fowt_env.compare import CompareSettings, compare
@@ -428,11 +435,15 @@ class CompareSettings:
         d["train_cases"] = list(self.train_cases)
         d["band"] = list(self.band)
         d["train_files"], d["test_files"] = list(self.train_files), list(self.test_files)
+        for name in ("train_files", "test_files", "truth_effects", "channel_map"):
+            if not d[name]:  # unused: left out, so that results and campaigns of earlier versions still match
+                del d[name]
         d["channels"] = self.channels
         return d
 
     def _key(self, *names: str) -> str:
         d = self.to_dict()
+        d.update({n: getattr(self, n) for n in names if n not in d})  # the unused ones to_dict leaves out
         return json.dumps({n: d[n] for n in names} if names else d, sort_keys=True, default=str)
 
 
