@@ -27,7 +27,7 @@ Examples
 >>> rec = surrogates.Record(t, np.column_stack([np.sin(2 * np.pi * 0.1 * t), 11.0 + 0 * t]),
 ...                         ["Wave1Elev", "Wind1VelX"], ["m", "m/s"])
 >>> src = ReplaySource(rec)
->>> src.t_begin, src.t_end, round(src.case.wind_speed, 1)
+>>> src.t_begin, round(src.t_end, 9), round(src.case.wind_speed, 1)
 (0.0, 299.95, 11.0)
 """
 
@@ -224,6 +224,11 @@ class _Scan:
         self.n += t.size
         self._welch(x[:, 0])
 
+    @property
+    def mean_step(self) -> float:
+        """The grid's step (s) from its first and last time stamps (so that the grid ends where the record does)."""
+        return (self.t_last - self.t0) / (self.n - 1)
+
     def _welch(self, x: np.ndarray) -> None:
         """Welch periodogram of the elevation as scipy.signal.welch (Hann, 50 %, constant detrend), streamed."""
         nper = int(round(_WELCH_S / self.step))
@@ -376,7 +381,7 @@ class ReplaySource:
         t_rows.close()
         y_rows.close()
         self._check_span(scan, str(path))
-        series = NpzSeries(path, [("y", cols)], scan.t0, scan.step)
+        series = NpzSeries(path, [("y", cols)], scan.t0, scan.mean_step)
         self._series.append(series)
         return series, scan
 
@@ -394,7 +399,7 @@ class ReplaySource:
         for i0 in range(0, t.size, _BLOCK_ROWS):
             scan.block(t[i0:i0 + _BLOCK_ROWS], x[i0:i0 + _BLOCK_ROWS])
         self._check_span(scan, "the record")
-        return ArraySeries(scan.t0, scan.step, x), scan
+        return ArraySeries(scan.t0, scan.mean_step, x), scan
 
     @staticmethod
     def _check_span(scan: _Scan, name: str) -> None:
@@ -437,7 +442,7 @@ class ReplaySource:
                 raise ValueError(f"replay_wind: {p}: the time axis is not finite, increasing and regular")
             t_last = float(t[-1])
         t_rows.close()
-        series = NpzSeries(p, [("hub_uvw", [0]), ("polar_u", None)], t_first, step)
+        series = NpzSeries(p, [("hub_uvw", [0]), ("polar_u", None)], t_first, (t_last - t_first) / (n - 1))
         self._series.append(series)
         cols = slice(1, 1 + radii.size * az.size)
         return StreamedWind(series, "field", hub_column=0, field_columns=cols, radii=radii, azimuth_rad=az)

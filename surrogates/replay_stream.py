@@ -10,7 +10,8 @@ measured samples that window needs from a :class:`MeasuredSeries` (an in-memory 
 Overlapping chunks with tapered edges
 -------------------------------------
 The wave kinematics (elevation -> excitation and particle velocities along the spar) and the hub -> rotor-
-effective wind filter are FFT filters, i.e. convolutions with kernels a few seconds long. For a window
+effective wind filter are FFT filters, i.e. convolutions whose kernels decay within seconds (the wave loads) to
+about a minute (the wind filter, ~ L_c / V; the 1/t tails of the 2 Hz band edge longer still). For a window
 ``[t_a, t_b]`` the measured series is read over ``[t_a - margin_s, t_b + margin_s]`` (clipped to the record),
 the *record's* mean is removed (found once by the caller's scan, not the segment's: the elevation passes the
 local mean through), the segment is mirror-extended over ``taper_s`` and faded at both ends exactly as the
@@ -18,10 +19,15 @@ whole-record transform does (:func:`surrogates.replay._extend`), zero-padded, fi
 ``[t_a, t_b]`` is kept. At the record's own ends the segment's treatment is the whole record's; at an interior
 seam the unknown neighbour is stood in for by the real samples of the margin, so the difference from the
 whole-record transform is the kernels' tails beyond ``margin_s`` (and the brick-wall band edge on a different FFT
-grid). Measured (``benchmarks/replay_env.py --seams``, JONSWAP Hs 6 m Tp 10 s sampled at 20 Hz, 2 h, 600 s
-windows): with the default 60 s margin the largest deviation over all seams is below 1e-6 of each series' std
-for the excitation and strip velocities and 2e-5 for the elevation (its 2 Hz brick wall rings longest); the
-hub -> rotor-effective wind is below 1e-9 of its std. :data:`SEAM_TOLERANCE` states the bound the tests hold.
+grid). A transfer function whose value at f = 0 differs from its limit (the strip velocities: 0 at DC,
+``sqrt(g / h)`` just above on finite depth) leaves a constant over the whole transform that depends on its FFT
+length; :func:`whole_record_dc` computes the whole record's from its ends, and each window carries that one
+instead of its own (without it the deepest strips were off by 13-29 % of their std). Measured
+(``benchmarks/replay_env.py --seams``: JONSWAP Hs 5 m, Tp 10 s and Kaimal 12 m/s sampled at 20 Hz, 2 h, 600 s
+windows, margins 120 s for the waves and 480 s for the hub wind): the largest deviation over the record, as a
+fraction of each series' std, is 2.8e-7 for the wave loads (excitation and the drag's), 1.1e-8 for the
+rotor-effective wind, and 1.7e-4 for the elevation and 1.1e-4 for the strip velocities, whose 2 Hz band edge rings
+longest (a brick wall's 1/t tails: the near-surface strips see it most). :data:`SEAM_TOLERANCE` states the bound.
 
 The pointwise wind levels (rotor-effective series, polar field: disc mean, gradients and blade winds per time
 sample) need no margin and are exact chunk by chunk.
@@ -64,9 +70,10 @@ DEFAULT_MARGIN_S = 120.0
 """Measured samples read beyond each side of a window before the wave FFT (s)."""
 DEFAULT_WIND_MARGIN_S = 480.0
 """The same for the hub -> rotor-effective wind filter, whose kernel decays over ~ L_c / V (s)."""
-SEAM_TOLERANCE = 1e-4
-"""Bound held by the tests on the chunked transform's deviation from the whole-record one, as a fraction of each
-series' standard deviation (measured values in the module docstring are one to two decades below it)."""
+SEAM_TOLERANCE = 3e-4
+"""Bound on the chunked transform's deviation from the whole-record one with the default margins, as a fraction of
+each forcing series' standard deviation (elevation and strip velocities; the wave loads and the rotor-effective
+wind are three or more decades below it, see the module docstring). The tests hold it."""
 
 
 @runtime_checkable
