@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+import numba
 import numpy as np
 from scipy.signal import lfilter
 
@@ -23,6 +24,17 @@ from .model import INPUT_BLOCKS, N_INPUT, N_STATE, FOWTModel
 from .simulate import N_EX, Simulator
 
 __all__ = ["StreamingSimulator"]
+
+
+@numba.njit(cache=True, nogil=True)
+def _noisy_sample(truth, e, white, ar, gain, state, out):
+    """One noisy sample: ``state = ar state + gain e[0, 0]`` (in place) and ``out = truth + white e[1] + state``,
+    channel by channel in the order numpy evaluates those expressions (``truth``, ``out``: (1, n); ``e``:
+    (2, 1, n))."""
+    for c in range(truth.shape[1]):
+        s = ar * state[c] + gain[c] * e[0, 0, c]
+        state[c] = s
+        out[0, c] = truth[0, c] + white[c] * e[1, 0, c] + s
 
 
 class StreamingSimulator:
@@ -211,10 +223,10 @@ class StreamingSimulator:
             return truth, truth
         e = self._noise_rng.standard_normal((2, n_samples, len(self.channels)))
         # AR(1) coloured part x_i = a x_{i-1} + sqrt(1 - a^2) sigma e_i, its state carried between calls
-        if n_samples == 1:  # the environment's usual step: the same arithmetic as below, fewer temporaries
-            state = self._ar * self._ar_state + self._ar_gain * e[0, 0]
-            self._ar_state = state
-            return truth + self._white * e[1] + state, truth
+        if n_samples == 1:  # the environment's usual step: the same arithmetic as below, in one compiled call
+            noisy = np.empty_like(truth)
+            _noisy_sample(truth, e, self._white, self._ar, self._ar_gain, self._ar_state, noisy)
+            return noisy, truth
         if n_samples <= 8:
             colored = np.empty((n_samples, len(self.channels)))
             state = self._ar_state
