@@ -228,8 +228,15 @@ def _cmd_fatigue(args: argparse.Namespace) -> int:
 def _cmd_modes(args: argparse.Namespace) -> int:
     import surrogates
 
-    model = surrogates.FOWTModel(_parse_effects(args.effects))
-    res = model.modal_analysis(_case(args.case) if args.case is not None else None)
+    from .progress import progress_bar
+
+    with progress_bar(2, "modes", unit="steps") as bar:  # shown on a terminal once it has run ~2 s
+        bar.set_postfix_str("model")
+        model = surrogates.FOWTModel(_parse_effects(args.effects))
+        bar.update(1)
+        bar.set_postfix_str("linearisation and eigenvalues")
+        res = model.modal_analysis(_case(args.case) if args.case is not None else None)
+        bar.update(1)
     print(res)
     if args.json:
         Path(args.json).write_text(json.dumps(res.as_table(), indent=2))

@@ -231,3 +231,11 @@ def test_the_clock_moves_while_a_c_call_holds_the_gil(tmp_path):
     assert code == 0, out
     elapsed = set(re.findall(r"held: +0%\|[^|]*\| 0/1 steps \[(\d\d:\d\d) elapsed", out))
     assert {"00:02", "00:03"} & elapsed, out  # redrawn during the call, not only before and after it
+
+
+@pytest.mark.slow  # ~5-10 s of subprocess; the class (a bar on a terminal) is covered by the default tests
+def test_modes_on_a_terminal_counts_its_two_steps():
+    code, out = _run_on_a_terminal([sys.executable, "-m", "fowt_env.cli", "modes", "--case", "7"])
+    assert code == 0, out
+    assert re.search(r"modes.*2/2 steps", out), out
+    assert "tower_fa_1" in out
