@@ -75,8 +75,7 @@ def test_a_fit_at_the_edge_of_the_search_range_is_a_bound_not_a_value(steady_3p)
 def test_a_truth_outside_the_candidates_is_unexplained_and_localised(steady_3p):
     """Blade passing hidden, but not among the candidates: the 3P findings are reported, nothing is named."""
     candidate = FULL.without("rotor_3p")
-    rep = discrepancy.run(steady_3p, candidate, STEADY, n_seeds=3, candidates=["p_delta", "tower_fa_stiffness",
-                                                                               "gyroscopic"])
+    rep = discrepancy.run(steady_3p, candidate, STEADY, n_seeds=3, candidates=["p_delta", "gyroscopic"])
     assert rep.verdict == "unexplained"
     _assert_names_nothing(rep, candidate)
     assert rep.gap_before > rep.detect_gap
@@ -107,11 +106,15 @@ def test_bad_input():
 
 
 # ------------------------------------------------------------------------------ hidden truths, 20-minute records
+# Each case gives the workflow the hidden truth among a few plausible decoys (the full candidate set is the
+# benchmark's job: benchmarks/discrepancy.py); the truth is set here, never read from the workflow's output.
 @pytest.mark.slow
 @pytest.mark.parametrize(
     "parameters, olc, seed, decoys",
     [
         ({"tower_fa_stiffness": 0.9}, 7, 51, ["tower_ss_stiffness", "p_delta", "platform_mass"]),
+        ({"mooring_line_1": 0.6}, 10, 54, ["mooring_line_2", "mooring_nonlinear", "platform_mass"]),
+        ({"platform_mass": 1.03}, 4, 55, ["platform_inertia", "added_mass", "mooring_line_1"]),
     ],
 )
 def test_a_hidden_parameter_change_is_recovered_within_its_interval(parameters, olc, seed, decoys):
@@ -121,5 +124,93 @@ def test_a_hidden_parameter_change_is_recovered_within_its_interval(parameters, 
     assert rep.verdict == "explained" and rep.effect == name, rep.summary()
     (fit,) = rep.fits
     assert fit["interval"][0] <= truth <= fit["interval"][1], rep.summary()
+    assert not any(fit["interval_at_bound"])
     assert rep.updated_model.parameters[name] == pytest.approx(rep.strength)
     assert rep.gap_after <= rep.accept_gap < rep.gap_before
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "effect, strength, olc, seed, decoys",
+    [
+        ("aero_damping", 1.0, 7, 31, ["p_delta", "structural_damping", "drag_cd"]),
+        ("mooring_nonlinear", 1.0, 4, 32, ["rotor_3p", "platform_mass", "mooring_line_1"]),
+    ],
+)
+def test_a_hidden_effect_is_named_within_its_interval(effect, strength, olc, seed, decoys):
+    """The earlier matrix, re-based: the effect is switched off in the candidate and present in the truth."""
+    measured = _measure(FULL.with_effects(**{effect: strength}), olc, seed)
+    candidate = FULL.without(effect)
+    before = candidate.effects
+    rep = discrepancy.run(measured, candidate, surrogates.load_case(olc), candidates=[effect, *decoys])
+    assert rep.verdict == "explained" and rep.effect == effect, rep.summary()
+    (fit,) = rep.fits
+    assert fit["interval"][0] <= strength <= fit["interval"][1], rep.summary()
+    assert rep.gap_after <= 0.5 * rep.gap_before
+    assert candidate.effects == before  # the given model is never modified
+    assert rep.updated_model.effects[effect] == pytest.approx(rep.strength)
+
+
+def _stiffness_loss():
+    return ParametricModel(parameters={"tower_fa_stiffness": 0.85})
+
+
+def _rotor_imbalance():
+    return FULL.with_effects(rotor_1p=4.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "truth, sea, candidates, olc, seed, bands, channels",
+    [
+        # a fore-aft stiffness loss with no stiffness candidate: the fore-aft tower peaks move down
+        (_stiffness_loss, {}, ["p_delta", "platform_mass", "platform_inertia", "added_mass", "structural_damping",
+                               "aero_damping"], 7, 52, {"tower_1_frequency", "tower_2_frequency"},
+         {"TwHt9ALxt", "TwHt1MLyt", "PtfmSurge", "PtfmPitch"}),
+        # a rotor four times as unbalanced as the nominal one, rotor_1p not a candidate: side-to-side 1P
+        (_rotor_imbalance, {}, ["rotor_3p", "rotor_asymmetry", "aero_damping", "tower_ss_stiffness", "gyroscopic"],
+         7, 53, {"1P"}, {"TwHt9ALyt", "TwHt1MLxt", "PtfmSway", "PtfmYaw"}),
+        # the sea has a Pierson-Moskowitz shape (gamma 1) where the model assumes JONSWAP gamma 3.3: the broader
+        # spectrum's tail drives the fore-aft response above the wave band (the 1P band at 0.2 Hz)
+        (lambda: FULL, {"gamma": 1.0}, ["drag_cd", "added_mass", "platform_mass", "quadratic_drag",
+                                        "platform_inertia"], 7, 61, {"1P", "wave"},
+         {"PtfmSurge", "PtfmPitch", "TwHt9ALxt", "TwHt1MLyt"}),
+    ],
+    ids=["stiffness_loss", "rotor_imbalance", "wave_spectrum_shape"],
+)
+def test_a_truth_outside_the_candidate_set_is_unexplained(truth, sea, candidates, olc, seed, bands, channels):
+    case = surrogates.load_case(olc)
+    measured = surrogates.simulate(truth(), case.replace(**sea), duration=DUR, dt=DT, seed=seed)
+    rep = discrepancy.run(measured, FULL, case, candidates=candidates)
+    assert rep.verdict == "unexplained", rep.summary()
+    _assert_names_nothing(rep, FULL)
+    top = rep.findings[:3]
+    assert top and all(f["band_or_statistic"] in bands and f["channel"] in channels for f in top), rep.summary()
+    assert all(abs(f["z"]) > 3 for f in top)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("olc", "seed"), [(7, 71), (4, 72), (10, 73), (3, 74), (7, 75)])
+def test_with_nothing_hidden_nothing_is_named(olc, seed):
+    """The null case with every candidate (20): the same physics as the model, another seed."""
+    rep = discrepancy.run(_measure(FULL, olc, seed), FULL, surrogates.load_case(olc))
+    assert rep.verdict == "none", rep.summary()
+    _assert_names_nothing(rep, FULL)
+
+
+@pytest.mark.slow
+def test_ten_minutes_of_a_missing_aerodynamic_damping_give_an_interval_or_say_the_record_is_short():
+    """The newcomer's case (issue 17): the candidate lacks aero_damping, 600 s of OLC 7, every candidate. The
+    answer is the truth (1.0) inside an interval, or no value at all -- never a search bound as a strength --
+    and the report says that 600 s is shorter than the verified length."""
+    measured = surrogates.simulate(FULL, 7, duration=600.0, dt=DT, seed=1)
+    rep = discrepancy.run(measured, FULL.without("aero_damping"), surrogates.load_case(7))
+    assert any("600 s long" in w for w in rep.warnings)
+    for fit in rep.fits:
+        assert not any(fit["interval_at_bound"]), rep.summary()
+    if rep.verdict == "explained":
+        assert rep.effect == "aero_damping", rep.summary()
+        lo, hi = rep.fits[0]["interval"]
+        assert lo <= 1.0 <= hi, rep.summary()
+    else:
+        assert rep.effect is None and rep.fits == []
