@@ -398,6 +398,8 @@ class SparEnv(gym.Env):
 
             plt.close(self._fig)
             self._fig = None
+        if self._replay is not None:  # the replayed record's files (reopened by a later reset)
+            self._replay.close()
 
     # ------------------------------------------------------------------------------------------ extras
     @property
