@@ -12,7 +12,7 @@ Examples
 >>> m = surrogates.FOWTModel()
 >>> rec = surrogates.simulate(m, 7, duration=60.0, seed=1)
 >>> rec.y.shape
-(4800, 45)
+(4800, 55)
 """
 
 from .channels import ALL_CHANNELS, GAUGE_HEIGHTS, OPENFAST_GAUGE_HEIGHTS, UNITS, tower_channels

@@ -615,14 +615,14 @@ class Simulator:
         return np.ascontiguousarray(u_ex[:-1] @ self.g_ex0.T + u_ex[1:] @ self.g_ex1.T)
 
     def outputs(self, x_hist: np.ndarray, u_ex_out: np.ndarray, u_hist: np.ndarray) -> np.ndarray:
-        """Channel values ``C x + D u`` from stored states and inputs (n, 45), with ``PtfmRoll`` and ``PtfmYaw`` as
+        """Channel values ``C x + D u`` from stored states and inputs (n, 55), with ``PtfmRoll`` and ``PtfmYaw`` as
         ElastoDyn reports them (:func:`elastodyn_platform_angles`)."""
         y = x_hist @ self.cy.T + u_ex_out @ self.dy[:, :N_EX].T + u_hist @ self.dy[:, N_EX:].T
         elastodyn_platform_angles(y, self._i_roll, self._i_pitch, self._i_yaw)
         return y
 
     def add_noise(self, y: np.ndarray, seed_sequence: np.random.SeedSequence) -> np.ndarray:
-        """Add white + AR(1) coloured sensor noise (model.noise) to outputs ``y`` (n, 45)."""
+        """Add white + AR(1) coloured sensor noise (model.noise) to outputs ``y`` (n, 55)."""
         white, col = self.model.noise.std(list(ALL_CHANNELS))
         if not np.any(white) and not np.any(col):
             return y
