@@ -249,3 +249,16 @@ def test_replayed_forcing_from_a_file_keeps_flat_memory(tmp_path):
         src.close()
     assert peaks[180] < 1.1 * peaks[40]  # measured 27.3 MiB for both
     assert peaks[180] < 200 * 2**20  # bytes: a 600 s window's arrays, not the 3 h record's
+
+
+def test_an_inflow_file_beside_the_record_is_the_default_wind(record_file, tmp_path):
+    rec, _ = record_file
+    path = tmp_path / "run.npz"
+    rec.save(path)
+    t = np.arange(0.0, 400.0, 0.2)
+    polar = np.full((t.size, 2, 4), 12.0, dtype=np.float16)
+    np.savez(tmp_path / "run.inflow.npz", t=t, hub_uvw=np.column_stack([12.0 + 0 * t, 0 * t, 0 * t]), polar_u=polar,
+             polar_radii=np.array([0.0, 63.0]), polar_azimuth_rad=np.arange(4) * np.pi / 2)
+    assert ReplaySource(path).wind.level == "field"
+    assert ReplaySource(path, wind="record").wind.level == "hub"
+    assert ReplaySource(rec).wind.level == "hub"
