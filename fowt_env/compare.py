@@ -825,6 +825,9 @@ def _channel_scores(truth: np.ndarray, est: np.ndarray, std: np.ndarray | None, 
         y, e = truth[:, j], est[:, j]
         bad = int(np.sum(~np.isfinite(e[h])))
         row["nonfinite_estimates"] = bad
+        # an estimate far outside anything the channel did: the sensor diverged (reported, scored as it is)
+        span = float(np.ptp(y)) or 1.0
+        row["diverged"] = bool(np.any(np.abs(e[h][np.isfinite(e[h])] - np.mean(y)) > _DIVERGED * span))
         if bad or h.sum() < 2:
             row.update(r2=None, nrmse=None, r2_band=None, nrmse_band=None)
         elif h.all():
@@ -839,6 +842,10 @@ def _channel_scores(truth: np.ndarray, est: np.ndarray, std: np.ndarray | None, 
             row["coverage95"] = float(np.mean(np.abs(y[h] - e[h]) <= 1.959964 * std[h, j]))
         rows.append(row)
     return rows
+
+
+_DIVERGED = 100.0
+"""An estimate further than this many times the truth's range from its mean marks the sensor as diverged."""
 
 
 def _hidden_scores(y: np.ndarray, e: np.ndarray, hidden: np.ndarray) -> tuple[float | None, float | None]:
@@ -1216,6 +1223,11 @@ class CompareResult:
                 f"{_fmt(row['median_r2_band'], '9.4f')}{_fmt(row['pooled_coverage95'], '7.3f')}"
                 f"{_fmt(row['worst_coverage95'], '9.3f')}"
                 f"{_fmt(speed.get(key), '9.1f')}")
+        diverged = sorted({(r["estimator"], r.get("record") or f"OLC {r['case']}") for r in self.runs
+                           if any(c.get("diverged") for c in r["channels"])})
+        for est, rec in diverged:
+            lines.append(f"warning: {est} diverged on {rec} (estimates beyond {_DIVERGED:g} x the hidden channel's "
+                         f"range): its scores there measure the divergence")
         if any(r["case_in_training"] for r in self.runs):
             lines.append("note: some test OLCs are training OLCs (unseen seeds, not unseen load cases)")
         if self.lyapunov and self.lyapunov.get("time_s") is not None:

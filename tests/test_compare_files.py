@@ -143,3 +143,22 @@ def test_a_channel_map_reads_tables_with_other_column_names(tmp_path, files_resu
     assert res.runs[0]["hidden"] == ref["hidden"]
     for a, b in zip(res.runs[0]["channels"], ref["channels"], strict=True):  # float32 npz vs CSV text
         assert a["r2"] == pytest.approx(b["r2"], abs=1e-6)
+
+
+def test_a_diverging_sensor_is_flagged(files_result):
+    class Runaway:  # follows the protocol, then runs away by 1e6 x the signal
+        def fit(self, data):
+            return self
+
+        def reconstruct(self, y, mask):
+            return np.where(mask, y, 1e12)
+
+    C.register_estimator("runaway", lambda dt, iv, *, channels=None, **o: Runaway(), uses_update_interval=False,
+                         replace=True)
+    try:
+        res = C.compare(["B"], ["runaway", "hold"], settings=files_result.settings, lyapunov_time=None)
+    finally:
+        del C.ESTIMATORS["runaway"]
+    flags = {r["estimator"]: [c["diverged"] for c in r["channels"]] for r in res.runs}
+    assert all(flags["runaway"]) and not any(flags["hold"])
+    assert "warning: runaway diverged on c_op12_Hs2p5_Tp10.npz" in res.summary()
