@@ -21,7 +21,7 @@ from scipy.signal import lfilter
 from .channels import ALL_CHANNELS
 from .load_cases import LoadCase
 from .model import INPUT_BLOCKS, N_INPUT, N_STATE, FOWTModel
-from .simulate import N_EX, Simulator
+from .simulate import N_EX, Simulator, elastodyn_platform_angles
 
 __all__ = ["StreamingSimulator"]
 
@@ -219,6 +219,7 @@ class StreamingSimulator:
             done += m
         self.time += n_samples * self.dt
         truth = buf @ self._cd.T
+        elastodyn_platform_angles(truth, sim._i_roll, sim._i_pitch, sim._i_yaw)  # as simulate() reports them
         if not noise or not self._noisy:
             return truth, truth
         e = self._noise_rng.standard_normal((2, n_samples, len(self.channels)))
