@@ -347,13 +347,23 @@ def _cmd_discrepancy(args: argparse.Namespace) -> int:
     from . import discrepancy
 
     measured = _load_record(args.measured, args.channel_map)
-    # an OpenFAST record has its tower gauges at the OC3 deck's nodes: the model measures where it does
+    # an OpenFAST record has its tower gauges at the OC3 deck's nodes and no sensor noise: the model measures
+    # where and as it does
     openfast = "openfast" in str(measured.meta.get("source", "")).lower() or Path(args.measured).suffix.lower() in (
         ".out", ".outb")
     model = surrogates.FOWTModel(_parse_effects(args.model_effects),
                                  gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS if openfast else None)
+    if openfast:
+        model = model.with_noise(scale=0.0)
+        print("OpenFAST record: the model has OpenFAST's gauge heights and no sensor noise")
     cands = args.candidates.split(",") if args.candidates else None
     case = _record_case(measured, args.case)
+    sidecar = Path(args.measured).with_suffix(".case.json")  # an OpenFAST reference run's conditions beside it
+    if case is None and sidecar.is_file():
+        from .validation import surrogate_case
+
+        case = surrogate_case(json.loads(sidecar.read_text(encoding="utf-8")))
+        print(f"load case from {sidecar.name}: {case}")
     if case is None:
         raise _UsageError(f"{args.measured} does not state its load case: give --case (an OLC number)")
     t0 = time.perf_counter()
