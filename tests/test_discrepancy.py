@@ -116,6 +116,7 @@ def test_bad_input():
         ({"mooring_line_1": 0.6}, 10, 54, ["mooring_line_2", "mooring_nonlinear", "platform_mass"]),
         ({"platform_mass": 1.03}, 4, 55, ["platform_inertia", "added_mass", "mooring_line_1"]),
     ],
+    ids=["tower_fa_stiffness", "mooring_line_1", "platform_mass"],
 )
 def test_a_hidden_parameter_change_is_recovered_within_its_interval(parameters, olc, seed, decoys):
     ((name, truth),) = parameters.items()
@@ -136,6 +137,7 @@ def test_a_hidden_parameter_change_is_recovered_within_its_interval(parameters, 
         ("aero_damping", 1.0, 7, 31, ["p_delta", "structural_damping", "drag_cd"]),
         ("mooring_nonlinear", 1.0, 4, 32, ["rotor_3p", "platform_mass", "mooring_line_1"]),
     ],
+    ids=["aero_damping", "mooring_nonlinear"],
 )
 def test_a_hidden_effect_is_named_within_its_interval(effect, strength, olc, seed, decoys):
     """The earlier matrix, re-based: the effect is switched off in the candidate and present in the truth."""
