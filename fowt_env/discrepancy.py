@@ -524,9 +524,10 @@ def run(
     bar = progress_bar(estimate, "discrepancy", unit="simulations", progress=progress)
     try:
         ev = _Evaluator(case, measured.duration + dt, dt, channels, bar)
-        rep = _search(measured, model, base, case, cands, int(max_effects), int(n_refine), meas, seeds,
-                      scatter_seeds, screen_seeds, ev)
-        rep._spectra = _spectra(measured, base, rep, case, dt, seeds[0], ev)
+        rep, current = _search(measured, model, base, case, cands, int(max_effects), int(n_refine), meas, seeds,
+                               scatter_seeds, screen_seeds, ev)
+        runs = {"candidate": base} if rep.verdict != "explained" else {"candidate": base, "updated": current}
+        rep._spectra = _spectra(measured, runs, case, dt, seeds[0], ev)
         rep.n_simulations = ev.n_sims
         bar.total = bar.n
         bar.refresh()
@@ -595,8 +596,9 @@ class _Scale:
 
 def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: LoadCase, cands: list[_Candidate],
             max_effects: int, n_refine: int, meas: FeatureSet, seeds: list[int], scatter_seeds: list[int],
-            screen_seeds: list[int], ev: _Evaluator) -> DiscrepancyReport:
-    """:func:`run`'s screening, profiles and greedy selection.
+            screen_seeds: list[int], ev: _Evaluator) -> tuple[DiscrepancyReport, ParametricModel]:
+    """:func:`run`'s screening, profiles and greedy selection; returns the report and the final model as simulated
+    (the candidate, with the noise of the simulations, plus what was named).
 
     The gap of the candidate model and the screening and profiles use the candidate model's scatter; whether a
     fitted model explains the measurement, and its interval, are judged with the *fitted* model's own scatter and
@@ -704,13 +706,13 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
     for c, v, *_ in named:
         updated = c.apply(updated, v) if c.kind == "parameter" else updated.with_effects(**{c.name: v})
     effects = [(c.name, float(v)) for c, v, *_ in named]
-    return DiscrepancyReport(
+    report = DiscrepancyReport(
         verdict=verdict, effect=effects[0][0] if effects else None, strength=effects[0][1] if effects else None,
         effects=effects, fits=fits_out, at_bound=bounded, gap_before=gap0, gap_after=float(np.mean(z1**2)),
         null_gap=float(np.median(ref.null)), accept_gap=final.accept, detect_gap=ref.detect, null_gaps=ref.null,
         feature_names=list(meas.names), z_before=z0, z_after=z1, findings=findings, candidates=log,
-        warnings=warnings, duration=float(measured.duration), n_simulations=0, updated_model=updated, case=case,
-        _spectra={"_current": current})
+        warnings=warnings, duration=float(measured.duration), n_simulations=0, updated_model=updated, case=case)
+    return report, current
 
 
 def _fit(c: _Candidate, current: ParametricModel, s_pred: float, ev: _Evaluator, seeds: list[int], gap_of: Any,
@@ -764,11 +766,10 @@ def _extend(c: _Candidate, current: ParametricModel, points: dict[float, np.ndar
     return best, g, interval
 
 
-def _spectra(measured: Record, before: FOWTModel, rep: DiscrepancyReport, case: LoadCase, dt: float, seed: int,
-             ev: _Evaluator) -> dict:
-    current = rep._spectra.pop("_current")
+def _spectra(measured: Record, runs: dict[str, FOWTModel], case: LoadCase, dt: float, seed: int, ev: _Evaluator
+             ) -> dict:
+    """Welch PSDs of the figure's channels: the measurement and one simulation of each model in ``runs``."""
     out: dict = {}
-    runs = {"candidate": before} if rep.verdict != "explained" else {"candidate": before, "updated": current}
     for label, m in runs.items():
         rec = surrogates.simulate(m, case, duration=measured.duration + dt, dt=dt, seed=seed)
         ev.n_sims += 1
