@@ -85,6 +85,7 @@ def test_a_tls_scheduler_with_a_security_file_runs_tasks(tmp_path):
     read from a --scheduler-security file."""
     import distributed
 
+    pytest.importorskip("cryptography", reason="distributed.Security.temporary() needs cryptography (test extras)")
     sec = distributed.Security.temporary()
     creds = tmp_path / "security.json"
     creds.write_text(json.dumps({"tls_ca_file": sec.tls_ca_file, "tls_client_cert": sec.tls_client_cert,
