@@ -550,9 +550,9 @@ def _null_levels(fm: np.ndarray, kinds: Sequence[str], n_mean: int, subsets: int
 
 
 def _profile(points: dict[float, np.ndarray], gap_of_mean: Any, accept: float
-             ) -> tuple[float, float, tuple[float, float] | None, np.ndarray, np.ndarray]:
+             ) -> tuple[float, float, tuple[float, float] | None]:
     """Best value, its gap and the accepted interval from feature means at evaluated values (piecewise-linear
-    interpolation between them); also the fine grid and its gaps."""
+    interpolation between them)."""
     xs = np.array(sorted(points))
     means = np.array([points[x] for x in xs])
     grid = np.unique(np.concatenate([np.linspace(xs[0], xs[-1], 241), xs]))
@@ -570,7 +570,7 @@ def _profile(points: dict[float, np.ndarray], gap_of_mean: Any, accept: float
         while j1 < len(grid) - 1 and gaps[j1 + 1] <= accept:
             j1 += 1
         interval = (float(grid[j0]), float(grid[j1]))
-    return float(grid[i]), float(gaps[i]), interval, grid, gaps
+    return float(grid[i]), float(gaps[i]), interval
 
 
 @dataclass
@@ -748,7 +748,7 @@ def _extend(c: _Candidate, current: ParametricModel, points: dict[float, np.ndar
     """Profile on ``points``, adding points (in place) where the minimum or the accepted interval touches the
     evaluated hull inside the search range, or where the minimum lies far from every evaluated point."""
     h = 0.12 * (c.hi - c.lo)
-    best, g, interval, _, _ = _profile(points, gap_of, accept)
+    best, g, interval = _profile(points, gap_of, accept)
     for _ in range(max_extra):
         xs = sorted(points)
         lo_touch = (interval[0] if interval else best) <= xs[0] + 1e-9 and xs[0] > c.lo + 1e-9
@@ -762,7 +762,7 @@ def _extend(c: _Candidate, current: ParametricModel, points: dict[float, np.ndar
             _add_point(c, current, points, xs[-1] + h, ev, seeds)
         if far and not (lo_touch or hi_touch):
             _add_point(c, current, points, best, ev, seeds)
-        best, g, interval, _, _ = _profile(points, gap_of, accept)
+        best, g, interval = _profile(points, gap_of, accept)
     return best, g, interval
 
 
