@@ -110,6 +110,10 @@ def test_temporary_names_are_unique(tmp_path, monkeypatch):
     assert all(str(os.getpid()) in name for name in seen)
 
 
+def _default_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _helper_command(seconds: float, markers: Path, argv: list[str]) -> list[str]:
     return [sys.executable, HELPER, str(seconds), str(markers), "--", *argv]
 
@@ -141,7 +145,10 @@ def test_a_campaign_signalled_in_the_middle_of_a_task_resumes_with_exactly_the_m
     out, markers = tmp_path / "camp", tmp_path / "markers"
     markers.mkdir()
     argv = ["campaign", *CLI_SMALL, "--seeds", "3,4,5", "--estimators", "hold,slow", "--out", str(out)]
+    # SIGINT as a terminal user sends it: a child started from a background job (`cmd &` in a script, as CI may
+    # run) inherits SIGINT ignored, and Python then installs no KeyboardInterrupt handler; restore the default
     proc = subprocess.Popen(_helper_command(3.0, markers, argv), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            preexec_fn=_default_sigint,
                             text=True)
     try:
         deadline = time.monotonic() + 300

@@ -183,7 +183,8 @@ def test_simulate_replay_on_a_terminal_shows_the_records_seconds(tmp_path):
     assert code == 0, out
     bars = re.findall(r"replay: +\d+%\|[^|]*\| (\d+)/(\d+) s simulated \[\d\d:\d\d elapsed, ETA (\d\d:\d\d|\?)", out)
     assert bars and {total for _, total, _ in bars} == {"600"}, out  # the record's 600 s
-    assert any(n == total for n, total, _ in bars) and any(eta != "?" for *_, eta in bars)
+    counts = [int(n) for n, _, _ in bars]  # the final frame may be skipped (see the identify figures test)
+    assert counts == sorted(counts) and max(counts) > 0 and any(eta != "?" for *_, eta in bars)
 
 
 @pytest.mark.slow  # the class is covered by the default identify tests; ~10-17 s of subprocess
@@ -194,7 +195,10 @@ def test_identify_plot_on_a_terminal_counts_its_figures(record, tmp_path):
     assert code == 0, out
     bars = re.findall(r"figures: +\d+%\|[^|]*\| (\d+)/(\d+) figures \[\d\d:\d\d elapsed, ETA (\d\d:\d\d|\?)", out)
     assert bars and {total for _, total, _ in bars} == {"3"}, out  # eigenvalues, singular values, spectrogram
-    assert any(n == "3" for n, _, _ in bars) and len(list((tmp_path / "figs").glob("*.png"))) == 3
+    # counts never go back; the final frame itself may be skipped (tqdm redraws at most every 0.2 s and the bar is
+    # erased at close: under load the last figure can finish within that interval)
+    counts = [int(n) for n, _, _ in bars]
+    assert counts == sorted(counts) and len(list((tmp_path / "figs").glob("*.png"))) == 3
 
 
 def test_episode_on_a_terminal_shows_its_steps_from_the_set_up_on(tmp_path):
