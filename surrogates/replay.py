@@ -70,7 +70,7 @@ from scipy.fft import irfft, next_fast_len, rfft
 
 from .oc3 import WATER_DEPTH
 from .validation import check_number
-from .waves import SparGeometry, WaveLoads, _wave_transfer_rows
+from .waves import SparGeometry, WaveLoads, _loads_from_transfer_series, _wave_transfer_rows
 from .wind import rotor_averaging, rotor_plane_fit
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -271,14 +271,7 @@ class MeasuredWaves:
         series = np.empty((t_out.size, fine.shape[1]))
         for j in range(fine.shape[1]):
             series[:, j] = np.interp(t_out, t_fine, fine[:, j])
-        cb, sb = np.cos(beta), np.sin(beta)
-        excitation = np.zeros((t_out.size, 6))
-        excitation[:, 0] = series[:, 1] * cb
-        excitation[:, 1] = series[:, 1] * sb
-        excitation[:, 2] = series[:, 3]
-        excitation[:, 3] = -series[:, 2] * sb
-        excitation[:, 4] = series[:, 2] * cb
-        velocity = series[:, 4:, None] * np.array([cb, sb])
+        excitation, velocity = _loads_from_transfer_series(series, beta)
         n = self.elevation.size
         freqs = np.fft.rfftfreq(n, self.dt)
         per = 2.0 * np.abs(np.fft.rfft(self.elevation - self.elevation.mean())) ** 2 * self.dt / n

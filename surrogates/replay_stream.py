@@ -60,7 +60,7 @@ from .oc3 import WATER_DEPTH
 from .replay import _PAD_SECONDS, DEFAULT_TAPER_S, MIN_RECORD_SECONDS, _profile_disc_mean, blade_effective_wind
 from .simulate import N_BLADE_AZIMUTH, N_EX, Simulator
 from .validation import check_number
-from .waves import SparGeometry, _wave_transfer_rows
+from .waves import SparGeometry, _loads_from_transfer_series, _wave_transfer_rows
 from .wind import rotor_averaging, rotor_plane_fit
 
 __all__ = ["DEFAULT_MARGIN_S", "DEFAULT_WIND_MARGIN_S", "SEAM_TOLERANCE", "ArraySeries", "MeasuredSeries",
@@ -492,17 +492,11 @@ class ReplayForcing:
         series = self._wave_series(t, np.ascontiguousarray(block_w[:, wv.column]), ra[0],
                                    self._window_rows(wv.series, n_steps, sim.dt_int, wv.margin_s))
         beta = np.deg2rad(wv.direction_deg if wv.direction_deg is not None else lc.wave_dir_deg)
-        cb, sb = np.cos(beta), np.sin(beta)
         u_ex = np.zeros((n, N_EX))
         u_ex[:, 0] = 1.0
-        excitation = np.zeros((n_in, 6))
-        excitation[:, 0] = series[:, 1] * cb
-        excitation[:, 1] = series[:, 1] * sb
-        excitation[:, 2] = series[:, 3]
-        excitation[:, 3] = -series[:, 2] * sb
-        excitation[:, 4] = series[:, 2] * cb
+        excitation, vel_in = _loads_from_transfer_series(series, beta)
         vel = np.empty((n, sim.strip_z.size, 2))
-        vel[:n_in] = series[:, 4:, None] * np.array([cb, sb])
+        vel[:n_in] = vel_in
         u_ex[:n_in, INPUT_BLOCKS["wave"]] = excitation + sim.drag.excitation(vel[:n_in])
         u_ex[:n_in, INPUT_BLOCKS["elev"].start] = series[:, 0]
         hub, eff, shy, shz, blade_in = self._wind_series(

@@ -407,6 +407,20 @@ def _wave_transfer_rows(f: np.ndarray, depth: float, geo: SparGeometry, z: np.nd
     return rows
 
 
+def _loads_from_transfer_series(series: np.ndarray, beta: float) -> tuple[np.ndarray, np.ndarray]:
+    """Platform excitation (n, 6) and strip velocities (n, n_strips, 2) from the time series of the rows of
+    :func:`_wave_transfer_rows` (elevation, F_along, M_along, Fz, strip velocities) for waves travelling along
+    ``beta`` (rad from +x towards +y): the along-wave force and moment and the velocities resolved on x and y."""
+    cb, sb = np.cos(beta), np.sin(beta)
+    excitation = np.zeros((series.shape[0], 6))
+    excitation[:, 0] = series[:, 1] * cb
+    excitation[:, 1] = series[:, 1] * sb
+    excitation[:, 2] = series[:, 3]
+    excitation[:, 3] = -series[:, 2] * sb
+    excitation[:, 4] = series[:, 2] * cb
+    return excitation, series[:, 4:, None] * np.array([cb, sb])
+
+
 def excitation_rao(
     f_hz: np.ndarray,
     direction_deg: float = 0.0,
@@ -620,15 +634,7 @@ def synthesize_waves(
     spectra[:, active] = rows * (amp * (0.5 * n_fft))
     series = np.ascontiguousarray(irfft(spectra, n=n_fft, axis=-1)[:, :n_out].T)  # (n, 4 + n_strips)
 
-    beta = np.deg2rad(direction)
-    cb, sb = np.cos(beta), np.sin(beta)
-    excitation = np.zeros((n_out, 6))
-    excitation[:, 0] = series[:, 1] * cb
-    excitation[:, 1] = series[:, 1] * sb
-    excitation[:, 2] = series[:, 3]
-    excitation[:, 3] = -series[:, 2] * sb
-    excitation[:, 4] = series[:, 2] * cb
-    velocity = series[:, 4:, None] * np.array([cb, sb])
+    excitation, velocity = _loads_from_transfer_series(series, np.deg2rad(direction))
     meta = {
         "hs": hs, "tp": tp, "gamma": gamma, "direction_deg": direction,
         "seed": int(seed) if isinstance(seed, int | np.integer) else None, "depth": depth, "dt": dt,
