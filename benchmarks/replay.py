@@ -25,8 +25,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 DEFAULT_REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "openfast" / "runs"
 SCORED = ("PtfmSurge", "PtfmHeave", "PtfmPitch", "TwrBsMyt", "TwHt9ALxt", "RotSpeed", "BldPitch1")
 EXTRA = ("PtfmRoll", "PtfmYaw", "TwrBsMxt", "TwHt9ALyt", "RotThrust", "GenPwr")
@@ -36,7 +34,7 @@ PLOT = ("Wave1Elev", "Wind1VelX", "PtfmSurge", "PtfmHeave", "PtfmPitch", "TwrBsM
 
 def replay_run(folder: Path, level: str, transient: float, dt: float) -> dict:
     from fowt_env.io import load_record
-    from fowt_env.replay import replay_record, replay_scores
+    from fowt_env.replay import inflow_rotor_wind, replay_record, replay_scores
     from surrogates.replay import MeasuredWind
 
     name = folder.name
@@ -47,10 +45,7 @@ def replay_run(folder: Path, level: str, transient: float, dt: float) -> dict:
     t0 = time.perf_counter()
     rp = replay_record(rec, case=case, wind=wind, transient=transient, dt=dt)
     wall = time.perf_counter() - t0
-    rotor_wind = None
-    if inflow.is_file():
-        with np.load(inflow, allow_pickle=False) as z:
-            rotor_wind = (np.asarray(z["t"], float), np.asarray(z["disc_mean_u"], float))
+    rotor_wind = inflow_rotor_wind(inflow) if inflow.is_file() else None
     scores = replay_scores(rec, rp, rotor_wind, channels=SCORED + EXTRA)
     return {"run": name, "record": rec, "replay": rp, "scores": scores, "wall_s": wall,
             "level": level if wind is not None else "hub (Wind1VelX)"}

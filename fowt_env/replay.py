@@ -46,6 +46,7 @@ __all__ = [
     "band_pass",
     "band_r2",
     "coherence_bound",
+    "inflow_rotor_wind",
     "multiple_coherence",
     "record_case",
     "record_initial",
@@ -281,6 +282,13 @@ def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: A
         init.pop("Azimuth", None)
     return surrogates.simulate(model, lc, dt=dt, seed=seed, transient=transient, noise=False, initial=init,
                                waves=waves_in, wind=wind_in, on_progress=on_progress)
+
+
+def inflow_rotor_wind(path: str | os.PathLike[str]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The disc-averaged wind ``(t, u)`` (s, m/s) of an OpenFAST reference ``*.inflow.npz``: the rotor-averaged
+    input of the coherence bound (``replay_scores(..., rotor_wind=...)``)."""
+    with np.load(path, allow_pickle=False) as z:
+        return np.asarray(z["t"], float), np.asarray(z["disc_mean_u"], float)
 
 
 @dataclass

@@ -1271,17 +1271,19 @@ sample (positions, rotor speed), not from its velocities; 100 s are about ten pi
 def _replay_operating(run: ReferenceRun, model: Any, seeds: Sequence[int], dt: float,
                       report: ValidationReport) -> list[Any]:
     """Replays of one operating run (one per seed: the rotor's initial azimuth), scored into ``report.replay``."""
-    from .replay import replay_record, replay_scores
+    from surrogates.replay import MeasuredWind
+
+    from .replay import inflow_rotor_wind, replay_record, replay_scores
 
     inflow = Path(run.source).with_name(f"{run.name}.inflow.npz") if run.source else None
-    wind = inflow if inflow is not None and inflow.is_file() else None
+    has_inflow = inflow is not None and inflow.is_file()
+    wind = MeasuredWind.from_inflow(inflow) if has_inflow else None  # read once for every seed
     case = _with_measured_inputs(run)
     sims = [replay_record(run.record, case=case, wind=wind, model=model, transient=REPLAY_TRANSIENT_S, dt=dt,
                           seed=int(s)) for s in seeds]
     rotor_wind = None
-    if wind is not None:
-        with np.load(wind, allow_pickle=False) as z:
-            rotor_wind = (np.asarray(z["t"], float), np.asarray(z["disc_mean_u"], float))
+    if has_inflow:
+        rotor_wind = inflow_rotor_wind(inflow)
     else:
         report.notes.append(f"{run.name}: no {run.name}.inflow.npz beside the record: replayed Wind1VelX (hub "
                             f"wind, no rotor field)")
