@@ -220,7 +220,7 @@ class DiscrepancyReport:
         Per screened or profiled candidate and greedy round: effect (name), kind, strength (best value), gap,
         predicted (screening prediction or profile), accepted (bool).
     warnings : list of str
-        Short record, fits at the search bound.
+        Short record, fits at the search bound, a marginal gap that no change explains better than none.
     duration : float
         Length of the measured record (s).
     n_simulations : int
@@ -228,6 +228,12 @@ class DiscrepancyReport:
     updated_model : FOWTModel
         The candidate with the named candidates applied (the candidate itself unless "explained").
     case : LoadCase
+    alternatives : list of dict
+        Other profiled candidates that explain the record as well as a named one (their fit inside the search range,
+        the same significance against the gap before, the gap at or below the acceptance level): ``name``,
+        ``kind``, ``value``, ``interval``, ``gap`` and ``instead_of`` (the named candidate they could replace).
+        Non-empty means the features cannot tell these candidates apart (e.g. platform pitch inertia and added
+        mass, which both set the pitch inertia): the named one is the better fit, not the established one.
     """
 
     verdict: str
@@ -252,6 +258,8 @@ class DiscrepancyReport:
     n_simulations: int
     updated_model: FOWTModel
     case: LoadCase
+    alternatives: list[dict] = field(default_factory=list)
+    mode: str = "statistics"
     _spectra: dict = field(default_factory=dict, repr=False)
 
     def summary(self) -> str:
@@ -268,6 +276,11 @@ class DiscrepancyReport:
             what = "effect" if fit["kind"] != "parameter" else "parameter"
             lines.append(f"named {what}: {fit['name']} at {fit['value']:.2f} (accepted range {lo_s} to {hi_s}) "
                          f"-- {doc}")
+        for alt in self.alternatives:
+            lo, hi = alt["interval"]
+            lines.append(f"  equally consistent with the record instead of {alt['instead_of']}: {alt['name']} at "
+                         f"{alt['value']:.2f} (accepted range {lo:.2f} to {hi:.2f}, gap {alt['gap']:.2f}) -- these "
+                         "features cannot tell the two apart")
         for b in self.at_bound:
             sign = ">=" if b["side"] == "upper" else "<="
             lines.append(f"at the search bound: {b['name']} {sign} {b['bound']:.2f} would be needed (gap "
@@ -291,7 +304,8 @@ class DiscrepancyReport:
             "null_gaps": [float(g) for g in self.null_gaps],
             "features": {n: {"z_before": float(a), "z_after": float(b)}
                          for n, a, b in zip(self.feature_names, self.z_before, self.z_after, strict=True)},
-            "findings": self.findings, "candidates": self.candidates, "warnings": self.warnings,
+            "findings": self.findings, "candidates": self.candidates, "alternatives": self.alternatives,
+            "warnings": self.warnings,
             "duration": self.duration, "n_simulations": self.n_simulations,
             "updated_model": self.updated_model.to_dict(), "case": self.case.to_dict(),
         }
@@ -623,6 +637,7 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
     log: list[dict] = []
     named: list[tuple[_Candidate, float, tuple[float, float] | None, tuple[float, float]]] = []
     bounded: list[dict] = []
+    alternatives: list[dict] = []
     current, final = base, ref
     g_cur = gap0
     verdict = "none"
@@ -658,7 +673,7 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
                 fits.append((fit["gap"], len(fits), c, fit, log[-1]))
             g, _, c, fit, entry = min(fits)
             bic = n_f * math.log(g_cur / max(g, 1e-12)) > math.log(n_f) + 2.0
-            significant = bic and g_cur / max(g, 1e-12) > MIN_GAP_RATIO
+            significant = _improves(g_cur, g, n_f)
             if fit["at_bound"] is not None and bic:  # it points beyond its range: a bound, never a value
                 bounded.append({"name": c.name, "bound": fit["value"], "side": fit["at_bound"], "gap": g})
                 if g <= ref.accept and not named:
@@ -676,7 +691,25 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
                 interval = (fit["value"], fit["value"])
             else:
                 _, _, interval = _extend(c, current, points, gap_with(own), own.accept, ev, seeds)
+                s0 = c.value(current)
+                if interval is not None and interval[0] <= s0 <= interval[1]:
+                    # judged with its own scatter the fitted model accepts the value it started from: no change is
+                    # established (a gap just above the level, which 8 seeds estimate coarsely)
+                    warnings.append(f"marginal: the best candidate, {c.name}, accepts its starting value {s0:.2f} "
+                                    f"within its interval ({interval[0]:.2f} to {interval[1]:.2f}) once judged "
+                                    "with its own scatter; no change is established")
+                    entry.update(marginal=True)
+                    if rnd == 1 and g <= ref.accept:
+                        verdict = "none"
+                    break
             entry.update(accepted=True, own_gap=gap_with(own)(own.mean), own_accept=own.accept)
+            alternatives += [
+                {"name": c2.name, "kind": c2.kind, "value": float(f2["value"]), "interval": list(f2["interval"]),
+                 "gap": float(g2), "instead_of": c.name}
+                for g2, _, c2, f2, _ in fits
+                if c2 is not c and f2["at_bound"] is None and f2["interval"] is not None and g2 <= ref.accept
+                and _improves(g_cur, g2, n_f)
+            ]
             named.append((c, fit["value"], interval, (c.lo, c.hi)))
             current, g_cur = fitted, g
             if gap_with(own)(own.mean) <= own.accept:
@@ -684,7 +717,7 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
                 break
             shortlist = [x[1] for x in preds[:2 * n_refine]]  # the next round re-screens the best of this one
     if verdict != "explained":
-        named, current, final = [], base, ref
+        named, current, final, alternatives = [], base, ref, []
     z1 = (meas.values - final.mean) / final.sigma
     findings = [
         {"feature": name, "channel": name.split(":")[0], "band_or_statistic": name.split(":")[1], "z": float(z),
@@ -711,8 +744,16 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
         effects=effects, fits=fits_out, at_bound=bounded, gap_before=gap0, gap_after=float(np.mean(z1**2)),
         null_gap=float(np.median(ref.null)), accept_gap=final.accept, detect_gap=ref.detect, null_gaps=ref.null,
         feature_names=list(meas.names), z_before=z0, z_after=z1, findings=findings, candidates=log,
-        warnings=warnings, duration=float(measured.duration), n_simulations=0, updated_model=updated, case=case)
+        warnings=warnings, duration=float(measured.duration), n_simulations=0, updated_model=updated, case=case,
+        alternatives=alternatives)
     return report, current
+
+
+def _improves(g_old: float, g_new: float, n_features: int) -> bool:
+    """Whether a gap ``g_new`` is a significant improvement on ``g_old``: by :data:`MIN_GAP_RATIO` and by the
+    BIC-like test ``n_features ln(g_old / g_new) > ln n_features + 2`` (one parameter fitted)."""
+    ratio = g_old / max(g_new, 1e-12)
+    return n_features * math.log(ratio) > math.log(n_features) + 2.0 and ratio > MIN_GAP_RATIO
 
 
 def _fit(c: _Candidate, current: ParametricModel, s_pred: float, ev: _Evaluator, seeds: list[int], gap_of: Any,
