@@ -12,6 +12,7 @@ Examples
     fowt-env episode --case 5 --plane FA --fault scenario:A --fault dropout:0.1:2 --duration 120 --out ep.npz
     fowt-env identify olc7.npz --plane FA --json modes.json --plot figs
     fowt-env discrepancy measured.npz --case 7 --model-effects aero_damping=0 --json report.json --plot figs
+    fowt-env discrepancy measured.npz --case 7 --replay    # residuals under the record's own waves and wind
     fowt-env identify run.outb --json modes.json            # OpenFAST output (.out/.outb), CSV/Parquet too
     fowt-env sense olc7.npz --hide TwHt1ALxt,TwHt9MLyt --estimator dmd --out filled.npz --plot figs
     fowt-env compare --scenario A,B,C --estimators hold,kalman,dmd,koopman --json table.json --plot figs
@@ -368,7 +369,7 @@ def _cmd_discrepancy(args: argparse.Namespace) -> int:
         raise _UsageError(f"{args.measured} does not state its load case: give --case (an OLC number)")
     t0 = time.perf_counter()
     rep = discrepancy.run(measured, model, case, seed=args.seed, candidates=cands, n_seeds=args.seeds,
-                          progress=None)
+                          progress=None, replay=args.replay)
     print(rep.summary())
     print(f"({time.perf_counter() - t0:.1f} s)")
     if args.json:
@@ -817,6 +818,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--seeds", type=int, default=3, help="model simulations per setting (default 3)")
     q.add_argument("--seed", type=int, default=None,
                    help="first seed of the model simulations (default 1000; the next --seeds - 1 follow)")
+    q.add_argument("--replay", action="store_true",
+                   help="compare residual time series under the record's own waves and wind (its Wave1Elev and "
+                        "Wind1VelX channels) instead of statistics against the model's seed scatter")
     q.add_argument("--json", default=None, help="write the report as JSON")
     q.add_argument("--plot", default=None, help="folder for the figure")
     q.set_defaults(func=_cmd_discrepancy)

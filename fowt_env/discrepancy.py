@@ -35,7 +35,11 @@ how sure is that -- or is it something no candidate explains.
    significant and no candidate or combination brings it to the null level -- the findings are reported
    (channel, band or statistic, size in units of the model's seed scatter) and **no** effect is named, however
    much one of them reduces the gap.
-5. **Record length** -- the answers are verified by hidden-truth tests on 20-minute records
+5. **With replay** (``replay=True``, :mod:`fowt_env.discrepancy_replay`) -- when the record carries its wave
+   elevation and wind (``Wave1Elev``, ``Wind1VelX``), the features are instead the residuals of the measurement
+   against the model replayed under that forcing, per channel and band; the scatter and null come from the
+   model's own records replayed from their own forcing, and steps 2-4 apply unchanged.
+6. **Record length** -- the answers are verified by hidden-truth tests on 20-minute records
    (:data:`RELIABLE_DURATION`); a shorter record gets a warning in the report (intervals widen as the scatter
    grows; below 10 minutes the platform band holds only a few Welch segments).
 
@@ -72,6 +76,9 @@ CENTROID_BANDS = ("platform", "tower_1", "tower_2")  # modal bands whose centroi
 LOG_FLOOR = 0.05  # minimum scatter of a log band power (~5 %)
 CENTROID_FLOOR = 0.002  # minimum scatter of a log centroid frequency (0.2 %)
 MEAN_FLOOR = 0.02  # minimum scatter of a mean, relative to its magnitude (2 %)
+RESIDUAL_FLOOR = 0.01  # minimum scatter of a replay mode's log residual band power (~1 %)
+RATIO_FLOOR = 0.003  # minimum scatter of a replay mode's log power ratio, replayed over measured (0.3 %)
+MEAN_RESIDUAL_FLOOR = 0.005  # minimum scatter of a replay mode's mean residual (in measured standard deviations)
 MIN_GAP_RATIO = 1.3  # a named candidate must shrink the gap by at least this factor
 FAST_DT = 0.05  # default sample time of the model simulations (20 Hz covers every band)
 EFFECT_BOUNDS = (0.0, 3.0)  # search range of an effect's strength
@@ -186,6 +193,9 @@ class DiscrepancyReport:
     ----------
     verdict : {"none", "explained", "at_bound", "unexplained"}
         See the module docstring.
+    mode : {"statistics", "replay"}
+        Which features were compared: statistics against the model's seed scatter, or residuals against the
+        model replayed under the record's own waves and wind (:mod:`fowt_env.discrepancy_replay`).
     effect : str or None
         The first named candidate (an effect or a parameter), None unless the verdict is "explained".
     strength : float or None
@@ -264,7 +274,9 @@ class DiscrepancyReport:
 
     def summary(self) -> str:
         """A few lines for people."""
-        lines = [f"gap before: {self.gap_before:.2f}  (null level {self.null_gap:.2f}; significant above "
+        lines = ["replay mode: residuals of the measurement against the model driven by its own waves and wind"
+                 ] if self.mode == "replay" else []
+        lines += [f"gap before: {self.gap_before:.2f}  (null level {self.null_gap:.2f}; significant above "
                  f"{self.detect_gap:.2f}, explained at or below {self.accept_gap:.2f})"]
         if self.verdict == "none":
             lines.append("no significant discrepancy: the model explains the measurement within its own scatter")
@@ -297,7 +309,7 @@ class DiscrepancyReport:
     def to_dict(self) -> dict:
         """JSON-friendly form (without the model object: its description instead)."""
         return {
-            "verdict": self.verdict, "effect": self.effect, "strength": self.strength,
+            "verdict": self.verdict, "mode": self.mode, "effect": self.effect, "strength": self.strength,
             "effects": [list(e) for e in self.effects], "fits": self.fits, "at_bound": self.at_bound,
             "gap_before": self.gap_before, "gap_after": self.gap_after, "null_gap": self.null_gap,
             "accept_gap": self.accept_gap, "detect_gap": self.detect_gap,
@@ -326,7 +338,8 @@ class DiscrepancyReport:
                 if (label, ch) in self._spectra:
                     f, p = self._spectra[(label, ch)]
                     sel = f > 0
-                    ax.loglog(f[sel], p[sel], style, lw=1.0, label=label)
+                    shown = f"{label} (replayed)" if self.mode == "replay" and label != "measured" else label
+                    ax.loglog(f[sel], p[sel], style, lw=1.0, label=shown)
             for name, (lo, hi) in bands.items():
                 shrunk = [n for n, a, b in zip(self.feature_names, self.z_before, self.z_after, strict=True)
                           if n == f"{ch}:{name}" and abs(a) > 3 and abs(b) < 0.5 * abs(a)]
@@ -435,7 +448,8 @@ class _Evaluator:
 
 def _scatter(fm: np.ndarray, kinds: Sequence[str], reference: np.ndarray) -> np.ndarray:
     sd = fm.std(axis=0, ddof=1)
-    floors = {"log_power": LOG_FLOOR, "log_centroid": CENTROID_FLOOR, "shape": 0.05}
+    floors = {"log_power": LOG_FLOOR, "log_centroid": CENTROID_FLOOR, "shape": 0.05,
+              "log_residual": RESIDUAL_FLOOR, "log_ratio": RATIO_FLOOR, "mean_residual": MEAN_RESIDUAL_FLOOR}
     floor = np.array([MEAN_FLOOR * abs(r) + 1e-9 if k == "mean" else floors[k]
                       for k, r in zip(kinds, reference, strict=True)])
     return np.maximum(sd, floor)
@@ -452,10 +466,11 @@ def run(
     max_effects: int = 2,
     channels: Sequence[str] = DEFAULT_CHANNELS,
     sim_dt: float | None = None,
-    n_scatter: int = 8,
+    n_scatter: int | None = None,
     progress: bool | None = False,
     n_screen: int = 2,
     n_refine: int = 3,
+    replay: bool = False,
 ) -> DiscrepancyReport:
     """Find where a model and a measured record disagree and which named effect or parameter explains it.
 
@@ -485,8 +500,9 @@ def run(
     sim_dt : float, optional
         Sample time of the model simulations (s; default: the measured record's, but at least 0.05 s; when
         coarser, the model's white sensor noise is scaled so its spectral density matches the measurement's).
-    n_scatter : int
-        Realisations of the candidate model for its seed-to-seed scatter and the null gaps (>= n_seeds + 1).
+    n_scatter : int, optional
+        Realisations of the candidate model for its seed-to-seed scatter and the null gaps (>= n_seeds + 1;
+        default 8, with ``replay=True`` 16).
     progress : bool or None
         Progress in model simulations with an ETA on standard error (:func:`fowt_env.progress.progress_bar`):
         True, False (default) or None (when it is a terminal). The total is an estimate that grows if the search
@@ -495,6 +511,10 @@ def run(
         Seeds of the screening probe of every candidate (1 to n_seeds).
     n_refine : int
         Candidates profiled per greedy round (the best-screened ones).
+    replay : bool
+        Compare residual time series under the record's own forcing instead of statistics
+        (:mod:`fowt_env.discrepancy_replay`): the record must carry ``Wave1Elev`` (m) and ``Wind1VelX`` (m/s);
+        the model is replayed at the record's sample time (``sim_dt`` is not used).
 
     Returns
     -------
@@ -503,7 +523,8 @@ def run(
     Raises
     ------
     ValueError
-        Missing channels, bad sampling, unknown candidates, too few seeds.
+        Missing channels (with ``replay=True``: ``Wave1Elev`` or ``Wind1VelX``, named), bad sampling, unknown
+        candidates, too few seeds.
     """
     if not isinstance(measured, Record):
         raise ValueError(f"measured must be a surrogates.Record, got {type(measured).__name__}")
@@ -517,10 +538,21 @@ def run(
                          f"parameters: {sorted(PARAMETERS)}")
     if int(n_seeds) < 3:
         raise ValueError(f"n_seeds must be at least 3 (the scatter needs them), got {n_seeds}")
+    if n_scatter is None:  # the residual features of replay mode have heavier tails: more of the model's records
+        n_scatter = 16 if replay else 8
     if int(n_scatter) < int(n_seeds) + 1:
         n_scatter = int(n_seeds) + 1
     if strengths is not None and len(set(map(float, strengths))) < 2:
         raise ValueError(f"strengths must hold at least two different values, got {strengths!r}")
+    if replay:
+        from . import discrepancy_replay
+
+        discrepancy_replay.check_forcing(measured)
+        features(measured, case, channels)  # the channel and sampling checks of the statistical features
+        return discrepancy_replay.run(measured, model, case, seed=seed, names=names, n_seeds=int(n_seeds),
+                                      strengths=strengths, max_effects=int(max_effects), channels=channels,
+                                      n_scatter=int(n_scatter), progress=progress, n_screen=int(n_screen),
+                                      n_refine=int(n_refine))
     meas = features(measured, case, channels)
     dt = max(measured.dt, FAST_DT) if sim_dt is None else float(sim_dt)
     base = as_parametric(model)

@@ -1,0 +1,172 @@
+"""The discrepancy workflow with replay (``discrepancy.run(..., replay=True)``): the model is driven by the record's
+own wave elevation and wind and the residuals are compared. The truth is set here; the workflow only sees the
+record, the candidate model and the load case."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import fowt_env
+import surrogates
+from fowt_env import discrepancy, discrepancy_replay
+from fowt_env.cli import main
+from fowt_env.replay import band_r2
+
+FULL = surrogates.FOWTModel()
+DUR, DT = 1200.0, 0.1
+OPENFAST_RUN = Path(fowt_env.__file__).parent / "data" / "openfast_reference" / "c_op12_Hs2p5_Tp10.npz"
+
+
+def _measure(model, olc, seed, duration=DUR, **kw):
+    return surrogates.simulate(model, olc, duration=duration, dt=DT, seed=seed, **kw)
+
+
+@pytest.fixture(scope="module")
+def short_record():
+    return _measure(FULL, 7, seed=11, duration=300.0)
+
+
+# ------------------------------------------------------------------------------------------------ bad input
+@pytest.mark.parametrize("missing", ["Wave1Elev", "Wind1VelX"])
+def test_replay_on_a_record_without_its_forcing_is_a_value_error_naming_the_channel(short_record, missing):
+    rec = short_record.select([c for c in short_record.channels if c != missing])
+    with pytest.raises(ValueError, match=missing):
+        discrepancy.run(rec, FULL, 7, replay=True)
+    discrepancy.features(rec, surrogates.load_case(7))  # the statistical mode does not need it
+
+
+def test_replay_on_a_record_with_a_gap_in_its_wind_says_so(short_record):
+    y = short_record.y.copy()
+    y[100, short_record.channels.index("Wind1VelX")] = np.nan
+    with pytest.raises(ValueError, match="Wind1VelX.*NaN"):
+        discrepancy.run(short_record.replace(y=y), FULL, 7, replay=True)
+
+
+def test_cli_replay_without_a_wave_elevation_is_a_one_line_error(short_record, tmp_path, capsys):
+    path = short_record.select([c for c in short_record.channels if c != "Wave1Elev"]).save(tmp_path / "m.npz")
+    assert main(["discrepancy", str(path), "--case", "7", "--replay"]) == 2
+    err = capsys.readouterr().err
+    assert "Wave1Elev" in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+# --------------------------------------------------------------------------------------------- the replay
+def test_a_noise_free_record_in_steady_wind_is_reproduced_by_its_own_model():
+    """Truth: the record's own model, with nothing unresolved (steady wind, no sensor noise): replayed from the
+    record's waves and wind it reproduces the record in the wave band (R² > 0.97: the platform's start-up from the
+    record's first sample is not over after 60 s, R² 0.986 for pitch, 0.999 after 200 s), and the power-ratio
+    features nearly vanish."""
+    case = surrogates.load_case(7).replace(turbulence_intensity=0.0)
+    rec = surrogates.simulate(FULL, case, duration=400.0, dt=DT, seed=3, noise=False)
+    rep = discrepancy_replay.replay_model(FULL, rec, case)
+    assert rep.t[0] == pytest.approx(rec.t[0] + discrepancy_replay.REPLAY_TRANSIENT)
+    i0 = int(np.searchsorted(rec.t, rep.t[0] - 1e-6))
+    for ch in ("PtfmPitch", "TwHt1MLyt", "TwHt9ALxt"):
+        y = rec[ch][i0:i0 + rep.n_samples]
+        assert band_r2(y, rep[ch], rec.fs, (0.05, 0.2)) > 0.97, ch
+    f = discrepancy_replay.replay_features(rec, rep, case)
+    ratio = dict(zip(f.names, f.values, strict=True))
+    for ch in ("PtfmPitch", "TwHt1MLyt", "TwHt9ALxt"):
+        assert abs(ratio[f"{ch}:wave_ratio"]) < 0.05, ch  # replayed / measured wave-band power within 5 %
+
+
+def test_a_replay_report_of_the_models_own_record_names_nothing_and_says_its_mode(short_record):
+    rep = discrepancy.run(short_record, FULL, 7, replay=True, candidates=["drag_cd"], n_scatter=4)
+    assert rep.mode == "replay" and rep.to_dict()["mode"] == "replay"
+    assert rep.summary().startswith("replay mode")
+    assert rep.effects == [] and rep.updated_model is FULL
+    assert any(n.endswith("_residual") for n in rep.feature_names)
+    assert any(n.endswith("_ratio") for n in rep.feature_names)
+    assert discrepancy.run.__defaults__ is not None  # the statistical mode stays the default:
+    stat = discrepancy.run(short_record, FULL, 7, candidates=["drag_cd"], n_scatter=4)
+    assert stat.mode == "statistics"
+
+
+# ------------------------------------------------------------------------ hidden truths (slow, 20 minutes)
+def _assert_names_nothing(rep, candidate):
+    assert rep.effect is None and rep.effects == [] and rep.fits == []
+    assert rep.updated_model is candidate
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("olc", "seed"), [(7, 106), (3, 201), (10, 202)])
+def test_replay_of_the_candidates_own_record_names_nothing(olc, seed):
+    """Truth: the candidate model itself (another seed). OLC 7 seed 106 is the record whose roll residual is
+    the largest of those tried (z = +6 to +9 in four roll bands against eight of the model's own records)."""
+    meas = _measure(FULL, olc, seed)
+    rep = discrepancy.run(meas, FULL, surrogates.load_case(olc), replay=True)
+    assert rep.mode == "replay" and rep.verdict == "none"
+    _assert_names_nothing(rep, FULL)
+    assert rep.gap_before <= rep.detect_gap
+
+
+def _names_the_truth_or_nothing(rep, name, truth, candidate):
+    """Never a wrong answer: the hidden candidate with an interval that holds the truth, or nothing named."""
+    if rep.effects:
+        assert [n for n, _ in rep.effects] == [name]
+        (fit,) = rep.fits
+        assert fit["interval"][0] <= truth <= fit["interval"][1]
+    else:
+        _assert_names_nothing(rep, candidate)
+
+
+@pytest.mark.slow
+def test_a_missing_quadratic_drag_at_rated_wind_is_never_misnamed_with_replay():
+    """Truth: the full model; the candidate lacks ``quadratic_drag`` (OLC 7, 12 m/s, Hs 3 m). Neither mode finds
+    it; replay mode must not name a decoy either. Its only trace is the platform-band surge power ratio (z about
+    -2.6 against the candidate's own records), diluted among 100 features (README, discrepancy with replay)."""
+    candidate = FULL.without("quadratic_drag")
+    meas = _measure(FULL, 7, seed=104)
+    rep = discrepancy.run(meas, candidate, surrogates.load_case(7), replay=True,
+                          candidates=["quadratic_drag", "drag_cd", "added_mass", "aero_damping"])
+    _names_the_truth_or_nothing(rep, "quadratic_drag", 1.0, candidate)
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="issue 17's target, not met: with the hub-height wind alone the unresolved "
+                   "turbulence in the platform band hides the quadratic drag's remainder (README)")
+def test_replay_names_a_missing_quadratic_drag_at_rated_wind():
+    candidate = FULL.without("quadratic_drag")
+    meas = _measure(FULL, 7, seed=104)
+    rep = discrepancy.run(meas, candidate, surrogates.load_case(7), replay=True,
+                          candidates=["quadratic_drag", "drag_cd", "added_mass", "aero_damping"])
+    assert rep.effect == "quadratic_drag"
+    assert rep.fits[0]["interval"][0] <= 1.0 <= rep.fits[0]["interval"][1]
+
+
+@pytest.mark.slow
+def test_a_drag_coefficient_of_one_and_a_half_is_never_misnamed_with_replay():
+    """Truth: ``drag_cd`` x1.5 (OLC 10, Hs 4 m); the candidate is nominal."""
+    meas = _measure(surrogates.parameters.ParametricModel(parameters={"drag_cd": 1.5}), 10, seed=104)
+    rep = discrepancy.run(meas, FULL, surrogates.load_case(10), replay=True,
+                          candidates=["drag_cd", "quadratic_drag", "added_mass", "structural_damping"])
+    _names_the_truth_or_nothing(rep, "drag_cd", 1.5, FULL)
+
+
+@pytest.mark.slow
+def test_replay_names_an_added_mass_ten_percent_high_that_the_statistics_miss():
+    """Truth: added mass x1.1 (OLC 7, seed 105). The statistical mode finds no significant discrepancy in this
+    record (gap 1.51 against its level 2.55); under the record's own waves the wave-band response of every channel
+    is known to a fraction of a percent, and replay mode sees the shifted transfer function."""
+    meas = _measure(surrogates.parameters.ParametricModel(parameters={"added_mass": 1.1}), 7, seed=105)
+    rep = discrepancy.run(meas, FULL, surrogates.load_case(7), replay=True,
+                          candidates=["added_mass", "platform_mass", "platform_inertia", "drag_cd"])
+    assert rep.verdict == "explained" and rep.effect == "added_mass"
+    (fit,) = rep.fits
+    assert fit["interval"][0] <= 1.1 <= fit["interval"][1]
+    assert not any(fit["interval_at_bound"])
+    assert rep.gap_after <= rep.accept_gap < rep.gap_before
+
+
+@pytest.mark.slow
+def test_cli_replay_on_the_packaged_openfast_run(tmp_path, capsys):
+    out = tmp_path / "rep.json"
+    code = main(["discrepancy", str(OPENFAST_RUN), "--replay", "--candidates", "added_mass,drag_cd",
+                 "--json", str(out)])
+    text = capsys.readouterr().out
+    assert code == 0
+    assert "OpenFAST record: the model has OpenFAST's gauge heights and no sensor noise" in text
+    assert "replay mode" in text
+    d = json.loads(out.read_text())
+    assert d["mode"] == "replay" and d["verdict"] in ("none", "explained", "at_bound", "unexplained")
