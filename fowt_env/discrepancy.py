@@ -205,7 +205,10 @@ class DiscrepancyReport:
     fits : list of dict
         Per named candidate: ``name``, ``kind`` ("effect", "parameter", "switch"), ``value``, ``interval``
         (lo, hi) of the accepted values (-), ``interval_at_bound`` (lo, hi: True where the interval reaches the
-        search range's edge, i.e. the true value may lie beyond) and ``bounds`` (the search range).
+        search range's edge, i.e. the true value may lie beyond), ``bounds`` (the search range) and
+        ``excludes_start`` (the starting value where the interval ends at it, exclusive: the profile judges every
+        value with the fitted model's scatter, which may accept the starting value that the significant gap
+        rejected with its own seeds; else None).
     at_bound : list of dict
         Candidates whose best fit lies at the edge of their search range: ``name``, ``bound`` (the edge value),
         ``side`` ("lower"/"upper"), ``gap`` -- reported as "<= bound" / ">= bound", never as a value.
@@ -230,7 +233,7 @@ class DiscrepancyReport:
         Per screened or profiled candidate and greedy round: effect (name), kind, strength (best value), gap,
         predicted (screening prediction or profile), accepted (bool).
     warnings : list of str
-        Short record, fits at the search bound, a marginal gap that no change explains better than none.
+        Short record, fits at the search bound.
     duration : float
         Length of the measured record (s).
     n_simulations : int
@@ -241,7 +244,8 @@ class DiscrepancyReport:
     alternatives : list of dict
         Other profiled candidates that explain the record as well as a named one (their fit inside the search range,
         the same significance against the gap before, the gap at or below the acceptance level): ``name``,
-        ``kind``, ``value``, ``interval``, ``gap`` and ``instead_of`` (the named candidate they could replace).
+        ``kind``, ``value``, ``interval``, ``interval_at_bound``, ``gap`` and ``instead_of`` (the named candidate
+        they could replace).
         Non-empty means the features cannot tell these candidates apart (e.g. platform pitch inertia and added
         mass, which both set the pitch inertia): the named one is the better fit, not the established one.
     """
@@ -284,14 +288,19 @@ class DiscrepancyReport:
             lo, hi = fit["interval"]
             lo_s = f"<= {lo:.2f} (search bound)" if fit["interval_at_bound"][0] else f"{lo:.2f}"
             hi_s = f">= {hi:.2f} (search bound)" if fit["interval_at_bound"][1] else f"{hi:.2f}"
+            if fit.get("excludes_start") is not None:  # an open end: the starting value is rejected
+                lo_s, hi_s = (f"{lo:.2f} (exclusive)", hi_s) if lo == fit["excludes_start"] else (
+                    lo_s, f"{hi:.2f} (exclusive)")
             doc = EFFECTS[fit["name"]].doc if fit["name"] in EFFECTS else PARAMETERS[fit["name"]].doc
             what = "effect" if fit["kind"] != "parameter" else "parameter"
             lines.append(f"named {what}: {fit['name']} at {fit['value']:.2f} (accepted range {lo_s} to {hi_s}) "
                          f"-- {doc}")
         for alt in self.alternatives:
             lo, hi = alt["interval"]
+            lo_s = f"<= {lo:.2f} (search bound)" if alt["interval_at_bound"][0] else f"{lo:.2f}"
+            hi_s = f">= {hi:.2f} (search bound)" if alt["interval_at_bound"][1] else f"{hi:.2f}"
             lines.append(f"  equally consistent with the record instead of {alt['instead_of']}: {alt['name']} at "
-                         f"{alt['value']:.2f} (accepted range {lo:.2f} to {hi:.2f}, gap {alt['gap']:.2f}) -- these "
+                         f"{alt['value']:.2f} (accepted range {lo_s} to {hi_s}, gap {alt['gap']:.2f}) -- these "
                          "features cannot tell the two apart")
         for b in self.at_bound:
             sign = ">=" if b["side"] == "upper" else "<="
@@ -670,6 +679,7 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
     named: list[tuple[_Candidate, float, tuple[float, float] | None, tuple[float, float]]] = []
     bounded: list[dict] = []
     alternatives: list[dict] = []
+    open_at: dict[str, float] = {}  # interval ends at a starting value that its own seeds reject (exclusive)
     current, final = base, ref
     g_cur = gap0
     verdict = "none"
@@ -724,19 +734,16 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
             else:
                 _, _, interval = _extend(c, current, points, gap_with(own), own.accept, ev, seeds)
                 s0 = c.value(current)
-                if interval is not None and interval[0] <= s0 <= interval[1]:
-                    # judged with its own scatter the fitted model accepts the value it started from: no change is
-                    # established (a gap just above the level, which 8 seeds estimate coarsely)
-                    warnings.append(f"marginal: the best candidate, {c.name}, accepts its starting value {s0:.2f} "
-                                    f"within its interval ({interval[0]:.2f} to {interval[1]:.2f}) once judged "
-                                    "with its own scatter; no change is established")
-                    entry.update(marginal=True)
-                    if rnd == 1 and g <= ref.accept:
-                        verdict = "none"
-                    break
+                if interval is not None and interval[0] < s0 < interval[1]:
+                    # the profile judges every value with the fitted model's scatter, which may accept the starting
+                    # value; that value's own seeds reject it (the gap was significant), so the set ends there
+                    interval = (interval[0], s0) if fit["value"] < s0 else (s0, interval[1])
+                    open_at[c.name] = s0
             entry.update(accepted=True, own_gap=gap_with(own)(own.mean), own_accept=own.accept)
             alternatives += [
                 {"name": c2.name, "kind": c2.kind, "value": float(f2["value"]), "interval": list(f2["interval"]),
+                 "interval_at_bound": [bool(f2["interval"][0] <= c2.lo + 1e-6 * (c2.hi - c2.lo)),
+                                       bool(f2["interval"][1] >= c2.hi - 1e-6 * (c2.hi - c2.lo))],
                  "gap": float(g2), "instead_of": c.name}
                 for g2, _, c2, f2, _ in fits
                 if c2 is not c and f2["at_bound"] is None and f2["interval"] is not None and g2 <= ref.accept
@@ -763,7 +770,7 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
         eps = 1e-6 * (bounds[1] - bounds[0])
         fits_out.append({"name": c.name, "kind": c.kind, "value": float(v), "interval": [lo, hi],
                          "interval_at_bound": [bool(lo <= bounds[0] + eps), bool(hi >= bounds[1] - eps)],
-                         "bounds": list(bounds)})
+                         "bounds": list(bounds), "excludes_start": open_at.get(c.name)})
     for b in bounded:
         warnings.append(f"{b['name']}: the best fit lies at the edge of its search range ({b['side']} bound "
                         f"{b['bound']:.2f}); it is reported as a bound, not as a value")

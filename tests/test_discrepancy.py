@@ -1,6 +1,9 @@
 """The discrepancy workflow on data in which an effect or a parameter change is hidden (and on data in which
 nothing is): the truth is set here, the workflow only sees the record, the candidate model and the load case."""
 
+import json
+import os
+
 import numpy as np
 import pytest
 
@@ -14,6 +17,19 @@ DUR, DT = 1200.0, 0.1
 
 def _measure(model, olc, seed, duration=DUR):
     return surrogates.simulate(model, olc, duration=duration, dt=DT, seed=seed)
+
+
+def _log(kind, name, truth, case, seed, rep):
+    """Append the answer to the file named by ``FOWT_HIDDEN_TRUTH_LOG`` (JSON lines), if set: what
+    ``tools/discrepancy_hidden_truths.py`` turns into the README's table. The assertions do not depend on it."""
+    path = os.environ.get("FOWT_HIDDEN_TRUTH_LOG")
+    if path:
+        row = {"kind": kind, "name": name, "truth": truth, "case": case.name, "seed": seed, "verdict": rep.verdict,
+               "fits": rep.fits, "alternatives": rep.alternatives, "at_bound": rep.at_bound,
+               "gap_before": rep.gap_before, "gap_after": rep.gap_after, "accept": rep.accept_gap,
+               "detect": rep.detect_gap, "warnings": rep.warnings, "n_simulations": rep.n_simulations}
+        with open(path, "a", encoding="utf-8") as f:
+            f.write(json.dumps(row, default=float) + "\n")
 
 
 def _assert_names_nothing(rep, candidate):
@@ -108,29 +124,68 @@ def test_bad_input():
 # ------------------------------------------------------------------------------ hidden truths, 20-minute records
 # Each case gives the workflow the hidden truth among a few plausible decoys (the full candidate set is the
 # benchmark's job: benchmarks/discrepancy.py); the truth is set here, never read from the workflow's output.
+# a parked rotor in a 16 s swell from ahead: without the rotor's aerodynamic damping the platform's pitch resonance
+# (about 30 s) rings, and its frequency and damping show the platform's inertia and drag
+SWELL_PARKED = surrogates.load_case(12).replace(tp=16.0, wave_dir_deg=0.0, wind_speed=0.0, rotor_rpm=0.0,
+                                                turbulence_intensity=0.0, name="parked, 16 s swell from ahead")
+
+# Every parameter of surrogates.parameters but the drag coefficient hidden at two strengths, on either side of
+# nominal where the physics allows, under two load cases; the workflow searches all 20 candidates (10 effects + 10
+# parameters). The values are where 20 minutes of the channels show the change; smaller ones are not seen (README,
+# "Detection limits": e.g. structural damping x0.5, added mass x1.1, drag Cd x0.4-2.5, platform inertia at 12 m/s).
+PARAMETER_TRUTHS = [
+    ("tower_fa_stiffness", 0.90, 7, 51), ("tower_fa_stiffness", 0.95, 10, 131),
+    ("tower_ss_stiffness", 0.90, 7, 101), ("tower_ss_stiffness", 0.80, 4, 132),
+    ("platform_mass", 1.03, 4, 55), ("platform_mass", 0.97, 10, 133),
+    ("added_mass", 0.75, 4, 112), ("added_mass", 1.25, 7, 134),
+    ("mooring_line_1", 0.60, 10, 54), ("mooring_line_1", 0.80, 7, 135),
+    ("mooring_line_2", 0.60, 7, 105), ("mooring_line_2", 0.80, 10, 136),
+    ("mooring_line_3", 0.60, 4, 106), ("mooring_line_3", 0.80, 7, 137),
+    ("structural_damping", 2.0, 7, 107), ("structural_damping", 0.3, 4, 138),
+    ("platform_inertia", 0.60, SWELL_PARKED, 141), ("platform_inertia", 1.40, SWELL_PARKED, 143),
+]
+
+
+def _case(olc):
+    return olc if isinstance(olc, surrogates.LoadCase) else surrogates.load_case(olc)
+
+
+def _recovered(rep, name, truth):
+    """The fit of ``name`` -- named, or reported as an equally consistent alternative to the named one."""
+    for fit in [*rep.fits, *rep.alternatives]:
+        if fit["name"] == name:
+            return fit
+    raise AssertionError(f"{name} (truth {truth}) neither named nor an alternative:\n{rep.summary()}")
+
+
+# the cases .ci/run checks on every change; the rest carry the `matrix` mark and are run by hand (about 25 minutes
+# of CPU): `python -m pytest -m slow tests/test_discrepancy.py` or `python tools/discrepancy_hidden_truths.py`
+CI_PARAMETER_TRUTHS = {("tower_fa_stiffness", 0.90), ("mooring_line_2", 0.60)}
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize(
-    "parameters, olc, seed, decoys",
-    [
-        ({"tower_fa_stiffness": 0.9}, 7, 51, ["tower_ss_stiffness", "p_delta", "platform_mass"]),
-        ({"mooring_line_1": 0.6}, 10, 54, ["mooring_line_2", "mooring_nonlinear", "platform_mass"]),
-        ({"platform_mass": 1.03}, 4, 55, ["platform_inertia", "added_mass", "mooring_line_1"]),
-    ],
-    ids=["tower_fa_stiffness", "mooring_line_1", "platform_mass"],
-)
-def test_a_hidden_parameter_change_is_recovered_within_its_interval(parameters, olc, seed, decoys):
-    ((name, truth),) = parameters.items()
-    measured = _measure(ParametricModel(parameters=parameters), olc, seed)
-    rep = discrepancy.run(measured, FULL, surrogates.load_case(olc), candidates=[name, *decoys])
-    assert rep.verdict == "explained" and rep.effect == name, rep.summary()
-    (fit,) = rep.fits
+@pytest.mark.parametrize(("name", "truth", "olc", "seed"), [
+    pytest.param(*row, id=f"{row[0]}={row[1]}-" + (f"OLC{row[2]}" if isinstance(row[2], int) else "parked_swell"),
+                 marks=() if row[:2] in CI_PARAMETER_TRUTHS else pytest.mark.matrix)
+    for row in PARAMETER_TRUTHS])
+def test_a_hidden_parameter_change_is_recovered_within_its_interval(name, truth, olc, seed):
+    case = _case(olc)
+    measured = _measure(ParametricModel(parameters={name: truth}), case, seed)
+    rep = discrepancy.run(measured, FULL, case)
+    _log("parameter", name, truth, case, seed, rep)
+    assert rep.verdict == "explained", rep.summary()
+    fit = _recovered(rep, name, truth)
     assert fit["interval"][0] <= truth <= fit["interval"][1], rep.summary()
-    assert not any(fit["interval_at_bound"])
-    assert rep.updated_model.parameters[name] == pytest.approx(rep.strength)
+    assert not (fit["interval"][0] < 1.0 < fit["interval"][1]), rep.summary()  # the change is established
+    if any(fit.get("interval_at_bound", ())):  # an open end is said to be one
+        assert "(search bound)" in rep.summary()
+    if rep.effect == name:
+        assert rep.updated_model.parameters[name] == pytest.approx(rep.strength)
     assert rep.gap_after <= rep.accept_gap < rep.gap_before
 
 
 @pytest.mark.slow
+@pytest.mark.matrix
 @pytest.mark.parametrize(
     "effect, strength, olc, seed, decoys",
     [
@@ -174,9 +229,9 @@ def _rotor_imbalance():
          7, 53, {"1P"}, {"TwHt9ALyt", "TwHt1MLxt", "PtfmSway", "PtfmYaw"}),
         # the sea has a Pierson-Moskowitz shape (gamma 1) where the model assumes JONSWAP gamma 3.3: the broader
         # spectrum's tail drives the fore-aft response above the wave band (the 1P band at 0.2 Hz)
-        (lambda: FULL, {"gamma": 1.0}, ["drag_cd", "added_mass", "platform_mass", "quadratic_drag",
-                                        "platform_inertia"], 7, 61, {"1P", "wave"},
-         {"PtfmSurge", "PtfmPitch", "TwHt9ALxt", "TwHt1MLyt"}),
+        pytest.param(lambda: FULL, {"gamma": 1.0}, ["drag_cd", "added_mass", "platform_mass", "quadratic_drag",
+                                                     "platform_inertia"], 7, 61, {"1P", "wave"},
+                     {"PtfmSurge", "PtfmPitch", "TwHt9ALxt", "TwHt1MLyt"}, marks=pytest.mark.matrix),
     ],
     ids=["stiffness_loss", "rotor_imbalance", "wave_spectrum_shape"],
 )
@@ -191,16 +246,28 @@ def test_a_truth_outside_the_candidate_set_is_unexplained(truth, sea, candidates
     assert all(abs(f["z"]) > 3 for f in top)
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize(("olc", "seed"), [(7, 71), (4, 72), (10, 73), (3, 74), (7, 75)])
-def test_with_nothing_hidden_nothing_is_named(olc, seed):
-    """The null case with every candidate (20): the same physics as the model, another seed."""
-    rep = discrepancy.run(_measure(FULL, olc, seed), FULL, surrogates.load_case(olc))
-    assert rep.verdict == "none", rep.summary()
-    _assert_names_nothing(rep, FULL)
+# twenty records of the candidate model itself (another seed each) over the twelve OLCs
+NULL_RECORDS = [(7, 71), (4, 72), (10, 73), (3, 74), (7, 75)] + [(1 + i % 12, 200 + i) for i in range(15)]
 
 
 @pytest.mark.slow
+def test_with_nothing_hidden_nothing_is_named_in_19_of_20_records():
+    """The null case with every candidate (20): the same physics as the model, twenty other seeds. The workflow's
+    level is the 99th percentile of its null gap, so about one record in a hundred may be called significant; a
+    named effect in more than one of twenty would be a false discovery rate the level does not promise."""
+    answers = []
+    for olc, seed in NULL_RECORDS:
+        rep = discrepancy.run(_measure(FULL, olc, seed), FULL, surrogates.load_case(olc))
+        _log("null", None, None, surrogates.load_case(olc), seed, rep)
+        answers.append((olc, seed, rep.verdict, rep.effect, round(rep.gap_before, 2), round(rep.detect_gap, 2)))
+        if rep.verdict == "none":
+            _assert_names_nothing(rep, FULL)
+    assert sum(a[2] != "none" for a in answers) <= 1, answers
+    assert sum(a[3] is not None for a in answers) <= 1, answers
+
+
+@pytest.mark.slow
+@pytest.mark.matrix
 def test_ten_minutes_of_a_missing_aerodynamic_damping_give_an_interval_or_say_the_record_is_short():
     """The newcomer's case (issue 17): the candidate lacks aero_damping, 600 s of OLC 7, every candidate. The
     answer is the truth (1.0) inside an interval, or no value at all -- never a search bound as a strength --
