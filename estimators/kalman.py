@@ -39,11 +39,30 @@ one converges far too slowly here to be run over whole records: the lightly damp
 modes keep its gain changing for minutes.) The covariance recursion does not depend on the data, so it runs once
 per piece length, shared by all pieces, and stops once converged; the means of the pieces are propagated together,
 so a fit on ten minutes of 80 Hz data takes seconds.
+
+Under model mismatch (a model of one simulator or operating point, records of another: the shared OpenFAST runs)
+the sensor must not diverge silently. Three guards, each counted or reported:
+
+* the load level is searched only where the fitted model's stationary spread of every channel stays within
+  ``_MAX_PRIOR_STD`` (100) training standard deviations, EM stops before leaving that range, and a likelihood that
+  still rises at the limit falls back to the nominal levels, without EM, with a ``RuntimeWarning``
+  (:attr:`KalmanSensor.load_level_source_`). On noise-free OpenFAST records from other operating points the
+  likelihood kept rising up to alpha ~ 900-3000 (channel spreads of 1e4 training standard deviations); the
+  innovation covariance then had a condition number of ~1e15 and the estimates reached 1e10-1e17;
+* the innovation gate measures residuals against the filter's standard deviation *plus* the unmodelled error: the
+  calibration's, raised by a running estimate from the residuals themselves; and a gate that leaves the filter at
+  most half of its live channels for ``_DRIFT_S`` (0.5 s) is read as model drift, not sensor faults: the data are
+  re-admitted and the covariance widened (:attr:`KalmanSensor.n_drift_`). Before, on OpenFAST records the gate cut
+  the filter off from its live channels (tens of thousands of rejections) and it ran away;
+* an estimate or standard deviation beyond ``_DIVERGED_Z`` (100) training standard deviations is never returned:
+  the filter restarts from its stationary prior, warns once per stream and counts it (:attr:`KalmanSensor.
+  n_resets_`).
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
@@ -70,6 +89,11 @@ _CALIB_LEAD_S = 60.0  # time at the start of a stretch that only conditions the 
 _CALIB_MIN_FRACTION = 0.25  # calibrate on held-out data if there are at least this fraction of the fit's samples
 _COVERAGE = 0.95  # coverage the calibration aims the +-1.96 std intervals at
 _Z95 = 1.959963984540054  # two-sided 95 % standard normal quantile
+_MAX_PRIOR_STD = 100.0  # a fitted load model may give no channel a stationary std above this many training stds
+_DRIFT_S = 0.5  # the gate leaving at most half of the live channels for this long (s) is model drift, not faults
+_HARD_GATE = 3.0  # residuals beyond this many times gate_sigma are rejected; between 1 and 3 times, down-weighted
+_GATE_TAU_S = 10.0  # time constant (s) of the gate's running estimate of each channel's unmodelled error
+_DIVERGED_Z = 100.0  # an estimate (or its std) this many training stds from the mean: the filter has diverged
 
 
 class KalmanSensor:
@@ -114,6 +138,8 @@ class KalmanSensor:
     gate_sigma : float or None
         Innovation gate (standard deviations): a live channel whose leave-one-out residual (see Notes) exceeds
         this is ignored for that sample (counted in :attr:`n_gated_`). None or ``inf`` disables gating.
+        The standard deviation includes the unmodelled error (see Notes); a gate that rejects at least half of
+        the live channels for 0.5 s is suspended for a sample (model drift, :attr:`n_drift_`).
     em_iter : int
         Maximum number of EM E-steps (likelihood evaluations, SQUAREM extrapolations included) for the load
         covariance after the grid search (0: grid only).
@@ -147,6 +173,15 @@ class KalmanSensor:
         Time constant of the load model (s).
     process_noise_ : float
         Overall load level chosen by the grid search (or given), relative to the nominal levels (-).
+    load_level_source_ : {"likelihood", "nominal", "given"}
+        Where :attr:`process_noise_` comes from: the likelihood's maximum; the nominal level 1 (or the plausible
+        limit, if lower), because the likelihood still rose at the largest plausible level (the model does not fit
+        the training data; a ``RuntimeWarning`` says so; EM is not run: the same likelihood would shape the load
+        covariance, and on the OpenFAST runs it widened the channel spreads to 20-57 training standard deviations
+        and lowered the worst hidden-channel R² from 0.972 to 0.954); or ``process_noise``.
+    prior_std_ : ndarray (n_channels,)
+        Stationary standard deviation of each channel under the fitted load model (channel units); at most
+        ``_MAX_PRIOR_STD`` (100) times :attr:`scale_` when the level was learned.
     force_std_ : ndarray (n_unknown,)
         Stationary standard deviation of each load in the fitted model (input units: N, N·m, m/s); for the
         random walk, that of the AR(1) model with the same increments.
@@ -176,6 +211,17 @@ class KalmanSensor:
     n_blind_ : int
         Samples since :meth:`reset` at which no channel was used, so that the estimate is the model's pure
         prediction: no channel live (mask False or NaN everywhere), or every live one rejected by the gate.
+    n_drift_ : int
+        Times since :meth:`reset` that the gate was suspended for model drift: it had left the filter at most half
+        of its live channels for 0.5 s; every live channel was then used and the covariance widened by the
+        stationary one.
+    n_downweighted_ : int
+        Channel samples since :meth:`reset` whose residual was beyond the gate but within 3 times it: used with a
+        raised noise variance rather than rejected (see Notes).
+    n_resets_ : int
+        Times since :meth:`reset` that the filter diverged (an estimate or its standard deviation beyond 100
+        training standard deviations, or 10 stationary ones if more) and restarted from its stationary prior; the
+        first one in a stream raises a ``RuntimeWarning``. A diverged estimate is never returned.
     std_ : ndarray (n_channels,)
         Standard deviation of the latest estimate of each channel's true (noise-free) value (channel units): the
         filter's for the channels used at that sample; for the others (hidden, lost, gated) the filter's combined
@@ -219,6 +265,27 @@ class KalmanSensor:
     from those relations (its nonlinear loads) read as many leave-one-out standard deviations although every
     channel is well inside its prior band. On the OC3 surrogate without gravity in the accelerations this
     rejected good moment channels for 1.6 s after a 3 s blackout and made the hidden moments 4-25 times worse.
+
+    Both tests allow for the error the model does not know about. The variance of a residual is taken as the
+    larger of the filter's part scaled by the calibration factor squared (:attr:`interval_scale_`, which grows with
+    the filter's own uncertainty when many channels are lost) and the filter's plus the calibrated unmodelled
+    variance (:attr:`model_error_std_`) raised by a running estimate (time constant 10 s) of each channel's excess
+    of squared residual over the filter's variance; and it is multiplied by the running mean square (kept >= 1) of
+    the channel's standardised residuals. Each sample's contribution to both running estimates is capped at
+    ``gate_sigma^2`` so that a spike barely moves them. A residual beyond ``gate_sigma`` is down-weighted to the
+    gate (its noise variance raised so that it stands at ``gate_sigma``; Huber's weight, counted in
+    :attr:`n_downweighted_`); only beyond ``3 gate_sigma`` is it rejected. A model that is wrong (another
+    simulator, another operating point) has errors the filter's covariance knows nothing of, and that grow with the
+    response: on noise-free OpenFAST records the filter's own leave-one-out standard deviations were 3-59 times too
+    small, and a gate on them rejected 38,000-134,000 good channel samples per 10 minutes, cutting the filter off
+    from its data; a gate with the calibration alone still rejected a third of the live accelerometers at 18 m/s
+    (trained at 8 and 12 m/s), and rejecting (or fully down-weighting) 50 samples of two accelerometers when most
+    others were lost made a hidden one 20 training standard deviations wrong.
+    If the gate still leaves at most half of the live channels for 0.5 s, the prediction has drifted away from
+    the data (a fault hits a minority of channels): the next sample uses every live channel, with the stationary
+    covariance added to the prior's (:attr:`n_drift_`). Finally, an estimate or a standard deviation beyond
+    100 training standard deviations is a diverged filter: it restarts from the stationary prior and assimilates
+    the sample again (:attr:`n_resets_`, a ``RuntimeWarning`` at the first).
 
     The noise model is white: slowly varying (coloured) sensor errors and the model's own errors are read as
     structural response, which makes the filter's standard deviations of unmeasured channels optimistic. The
@@ -393,6 +460,13 @@ class KalmanSensor:
         ValueError
             Bad model or parameters, wrong channel count, mask shape, too little finite data.
 
+        Warns
+        -----
+        RuntimeWarning
+            If the likelihood still rises at the largest plausible load level (the model's stationary spread of a
+            channel at ``_MAX_PRIOR_STD`` = 100 training standard deviations): the level falls back to the nominal
+            one (:attr:`load_level_source_` ``"nominal"``) and EM is not run.
+
         Notes
         -----
         The likelihood is computed on the complete stretches (at least ``_MIN_SEGMENT`` samples with every channel).
@@ -448,24 +522,38 @@ class KalmanSensor:
         self._piece_len = max(_MIN_SEGMENT, min(_MAX_PIECE, _SMOOTHER_BYTES // (16 * n_aug * n_aug)))
         self._leads = [min(int(round(_LEAD_S / self._dt)), s.shape[0] // 5) for s in segments]
 
-        # grid search: load time constant(s) and overall level
+        # grid search: load time constant(s) and overall level, within the plausible levels
         self.search_ = []
         best = None
         for tau in self._taus:
             model = self._build(float(tau), self._nominal_force_std(float(tau), signal_var))
             q_unit = (1.0 - model["phi"] ** 2) * np.eye(model["p"])
+            cap = math.inf
             if self.process_noise is not None:
-                alpha = float(self.process_noise)
+                alpha, source = float(self.process_noise), "given"
                 ll, start = self._loglik_at(model, alpha**2 * q_unit, segments)
                 self.search_.append({"force_time_constant": float(tau), "process_noise": alpha, "log_likelihood": ll})
             else:
-                alpha, ll, start = self._search_alpha(model, q_unit, segments)
+                # the stationary std of every channel is proportional to alpha: cap alpha where the largest one
+                # reaches _MAX_PRIOR_STD training standard deviations
+                cap = _MAX_PRIOR_STD / max(float(self._prior_std(model, q_unit).max()), 1e-300)
+                alpha, ll, start, source = self._search_alpha(model, q_unit, segments, cap)
             if best is None or ll > best[2]:
-                best = (model, alpha, ll, start)
-        model, alpha, ll, start = best
+                best = (model, alpha, ll, start, source, cap)
+        model, alpha, ll, start, source, cap = best
+        self.load_level_source_ = source
+        if source == "nominal":
+            warnings.warn(
+                "KalmanSensor.fit: the innovation likelihood of the training data keeps rising with the load level "
+                f"up to the largest plausible one (alpha = {cap:.3g}, where the model's stationary "
+                f"spread of a channel reaches {_MAX_PRIOR_STD:g} times the training data's): the data do not "
+                "identify the level, the model does not fit them (model error, or training records at other "
+                "operating points). Using the nominal load levels (process_noise_ = "
+                f"{alpha:.3g}, load_level_source_ = 'nominal'), without EM (the same likelihood would shape them).",
+                RuntimeWarning, stacklevel=2)
         q_ff = alpha**2 * (1.0 - model["phi"] ** 2) * np.eye(model["p"])
         self.em_log_likelihood_ = []
-        if self.process_noise is None and self.em_iter > 0:
+        if source == "likelihood" and self.em_iter > 0:
             q_ff, self._r, ll = self._em(model, q_ff, self._r, ll, *start, learn_r=self.measurement_noise is None)
             self.measurement_noise_std_ = np.sqrt(self._r) * self.scale_
         self._model = model
@@ -475,6 +563,7 @@ class KalmanSensor:
         self.log_likelihood_ = ll
         phi_ref = model["phi"]
         self.force_std_ = np.sqrt(np.diag(q_ff) / (1.0 - phi_ref**2)) * model["force_std"]
+        self.prior_std_ = self._prior_std(model, q_ff) * self.scale_
         dq = np.sqrt(np.diag(q_ff))
         self.force_corr_ = q_ff / np.outer(dq, dq)
         self.n_channels_ = n_ch
@@ -565,6 +654,20 @@ class KalmanSensor:
         p0 = sla.solve_discrete_lyapunov(f_ar, self._q(model, q_ff))
         return 0.5 * (p0 + p0.T)
 
+    def _prior_std(self, model: dict, q_ff: np.ndarray) -> np.ndarray:
+        """Stationary standard deviation of each channel under the load covariance q_ff, in training standard
+        deviations (z-scored units, -); inf if the covariance cannot be computed."""
+        try:
+            p0 = self._initial_cov(model, q_ff)
+        except (np.linalg.LinAlgError, ValueError):
+            return np.full(model["H"].shape[0], np.inf)
+        v = np.einsum("ij,jk,ik->i", model["H"], p0, model["H"])
+        return np.where(np.isfinite(v), np.sqrt(np.maximum(v, 0.0)), np.inf)
+
+    def _plausible(self, model: dict, q_ff: np.ndarray) -> bool:
+        """True if no channel's stationary std under q_ff exceeds ``_MAX_PRIOR_STD`` training stds."""
+        return bool(self._prior_std(model, q_ff).max() <= _MAX_PRIOR_STD * (1.0 + 1e-9))
+
     def _loglik_at(self, model: dict, q_ff: np.ndarray, segments: list[np.ndarray]):
         """Log-likelihood per sample at the load covariance q_ff (and the current measurement noise), and the
         conditioned pieces (groups, prior covariance) that define it, None if the model has no steady state."""
@@ -574,15 +677,24 @@ class KalmanSensor:
             return -math.inf, None
         return start[2], start[:2]  # for its own reference model the exact filter is the steady-state one
 
-    def _search_alpha(self, model: dict, q_unit: np.ndarray, segments: list[np.ndarray]):
-        """Maximise the log-likelihood over log10(alpha): coarse grid, extension, parabolic steps. Returns
-        alpha, its log-likelihood and its conditioned pieces."""
+    def _search_alpha(self, model: dict, q_unit: np.ndarray, segments: list[np.ndarray], cap: float):
+        """Maximise the log-likelihood over log10(alpha) up to ``alpha <= cap``: coarse grid, extension, parabolic
+        steps. Returns alpha, its log-likelihood, its conditioned pieces and where alpha comes from
+        (``"likelihood"``, or ``"nominal"`` when the maximum sits at the cap).
+
+        ``cap`` is the level at which the model's stationary spread of some channel reaches ``_MAX_PRIOR_STD``
+        training standard deviations. A likelihood still rising there does not measure the loads: on noise-free
+        records of another simulator (OpenFAST) and training runs at other operating points it kept rising up to
+        alpha of several thousand (channel spreads thousands of times the data's), the innovation covariance then
+        having a condition number of ~1e15. The level then falls back to the nominal one, ``min(1, cap)``.
+        """
         cache: dict[float, float] = {}
         tau = float(model["tau"])
         best: list = [-math.inf, None]  # log-likelihood and conditioned pieces of the best point so far
+        log_cap = math.log10(cap)
 
         def ll_at(logit: float) -> float:
-            key = round(logit, 6)
+            key = round(min(logit, log_cap), 6)
             if key not in cache:
                 ll, start = self._loglik_at(model, 10.0 ** (2 * key) * q_unit, segments)
                 cache[key] = ll
@@ -594,11 +706,11 @@ class KalmanSensor:
         step = 0.5
         for g in np.arange(-2.0, 2.0 + 1e-9, step):
             ll_at(float(g))
-        for _ in range(6):  # extend the grid while the maximum sits on its edge
+        for _ in range(6):  # extend the grid while the maximum sits on its edge (never beyond the cap)
             k_best = max(cache, key=ll_at)
             if k_best == min(cache):
                 ll_at(k_best - step)
-            elif k_best == max(cache):
+            elif k_best == max(cache) and k_best < round(log_cap, 6):
                 ll_at(k_best + step)
             else:
                 break
@@ -611,7 +723,14 @@ class KalmanSensor:
         k_best = max(cache, key=ll_at)
         if not np.isfinite(cache[k_best]):
             raise ValueError("fit: the innovation likelihood is not finite anywhere on the grid (model unusable?)")
-        return 10.0**k_best, cache[k_best], best[1]
+        if k_best < round(log_cap, 6) - 1e-6:
+            return 10.0**k_best, cache[k_best], best[1], "likelihood"
+        alpha = min(1.0, cap)
+        ll, start = self._loglik_at(model, alpha**2 * q_unit, segments)
+        if start is None:
+            raise ValueError("fit: the model has no steady-state filter at its nominal load levels (model unusable?)")
+        self.search_.append({"force_time_constant": tau, "process_noise": alpha, "log_likelihood": ll})
+        return alpha, ll, start, "nominal"
 
     def _em(self, model: dict, q_ff: np.ndarray, r: np.ndarray, ll: float, groups: dict, p0: np.ndarray,
             learn_r: bool) -> tuple[np.ndarray, np.ndarray, float]:
@@ -623,7 +742,9 @@ class KalmanSensor:
         start (mean, common covariance ``p0``) given by the starting point's steady-state filter: the M-step
         maximises the expected complete-data likelihood over the load covariance and the noise with those starts
         fixed, so every EM step raises the likelihood it reports. ``em_log_likelihood_`` lists the iterates
-        (rejected extrapolations are not iterates). Returns the best (q_ff, r, log-likelihood)."""
+        (rejected extrapolations are not iterates). An iterate whose loads give some channel a stationary std
+        above ``_MAX_PRIOR_STD`` training stds is not plausible (see :meth:`_search_alpha`): EM stops before it
+        (an extrapolation there is rejected). Returns the best (q_ff, r, log-likelihood)."""
         n, p = model["n"], model["p"]
         phi = 1.0 if self.force_model == "random_walk" else model["phi"]
         sel = slice(n, n + p)
@@ -666,6 +787,8 @@ class KalmanSensor:
         best = (q_ff, r, ll0)
         while budget >= 2:
             theta1 = m_step(mom0)
+            if not self._plausible(model, theta1[0]):
+                break
             ll1, mom1 = e_step(*theta1)
             budget -= 1
             if not math.isfinite(ll1):
@@ -674,6 +797,8 @@ class KalmanSensor:
             if ll1 > best[2]:
                 best = (*theta1, ll1)
             theta2 = m_step(mom1)
+            if not self._plausible(model, theta2[0]):
+                break
             ll2, mom2 = e_step(*theta2)
             budget -= 1
             if not math.isfinite(ll2):
@@ -685,8 +810,10 @@ class KalmanSensor:
             if budget >= 1 and np.linalg.norm(curv) > 0:
                 alpha = min(-np.linalg.norm(step) / np.linalg.norm(curv), -1.0)
                 theta_x = unpack(x0 - 2 * alpha * step + alpha**2 * curv)
-                ll_x, mom_x = e_step(*theta_x)
-                budget -= 1
+                ll_x, mom_x = -math.inf, None
+                if self._plausible(model, theta_x[0]):
+                    ll_x, mom_x = e_step(*theta_x)
+                    budget -= 1
                 if ll_x > ll2:
                     cand = (theta_x, ll_x, mom_x)
                     log.append(ll_x)
@@ -731,9 +858,23 @@ class KalmanSensor:
         self.n_gated_ = 0
         self.gated_counts_ = np.zeros(self.n_channels_, dtype=int)
         self.n_blind_ = 0
+        self.n_drift_ = 0
+        self.n_resets_ = 0
+        self.n_downweighted_ = 0
+        self._gate_run = 0  # consecutive samples at which the gate rejected at least half of the live channels
+        self._drift_samples = max(1, int(round(_DRIFT_S / self._dt)))
+        self._n_seen = 0
         self.screen_.reset()
         self._k, self._err_std = calibration_terms(self.interval_scale_, self.calibration_["loo_std"],
                                                    self.n_channels_)
+        # unmodelled error variance (z-units) the gate allows: the calibration's, raised by a running estimate
+        self._gate_var0 = (self._err_std / self.scale_) ** 2
+        self._gate_var = self._gate_var0.copy()
+        self._gate_ms = np.ones(self.n_channels_)  # running mean square of the gate's standardised residuals (>= 1)
+        self._gate_rate = min(1.0, self._dt / _GATE_TAU_S)
+        # divergence limit (z-units): _DIVERGED_Z, or 10 stationary stds of a model given implausibly wide loads
+        self._prior_var = np.maximum(np.einsum("ij,jk,ik->i", self._H, self._P0, self._H), 0.0)
+        self._z_limit = np.maximum(_DIVERGED_Z, 10.0 * np.sqrt(self._prior_var))
         self.std_ = unmeasured_std(
             np.sqrt(np.einsum("ij,jk,ik->i", self._H, self._P, self._H)) * self.scale_, self._k, self._err_std)
         self.input_estimate_ = np.zeros(len(self._iu))
@@ -787,65 +928,43 @@ class KalmanSensor:
             uk = np.asarray(u, dtype=float)
             if uk.shape != (len(self._ik),) or not np.all(np.isfinite(uk)):
                 raise ValueError(f"u must be {len(self._ik)} finite known inputs {self.known_inputs_}, got {u!r}")
+        self._n_seen += 1
+        gate = self.gate_sigma
+        gating = gate is not None and gate != math.inf
         x, p = self._x, self._P
-        updated = False
-        if live.any():
-            idx, h, r = self._rows_for(live)
-            z = (y[idx] - self.mean_[idx]) / self.scale_[idx]
-            if uk is not None:
-                z = z - self._Dk[idx] @ uk
-            pht = p @ h.T
-            s = h @ pht
-            s.flat[:: s.shape[0] + 1] += r
-            e = z - h @ x
-            gate = self.gate_sigma
-            gating = gate is not None and gate != math.inf
-            while e.size:
-                chol = _inv_chol(s)  # S = U'U, ui = U^-1, S^-1 = ui ui'
-                if chol is None:
-                    break
-                ui = chol[0]
-                we = ui.T @ e
-                if gating:
-                    # leave-one-out residual of each channel in standard deviations, (S^-1 e)_i / sqrt((S^-1)_ii):
-                    # the channel against the prediction from the prior *and the other channels*
-                    with np.errstate(over="ignore", invalid="ignore"):
-                        loo = np.abs(ui @ we) / np.sqrt(np.einsum("ij,ij->i", ui, ui))
-                    loo = np.where(np.isnan(loo), np.inf, loo)  # an overflowed residual is an outlier, not NaN
-                    # an outlier also surprises the prior: a channel within the gate of its own prior prediction
-                    # is what the model expects of it, whatever the others say (see Notes)
-                    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-                        prior = np.abs(e) / np.sqrt(np.diagonal(s))
-                    loo = np.where(np.isnan(prior) | (prior > gate), loo, 0.0)
-                    worst = int(np.argmax(loo))
-                    if loo[worst] > gate:
-                        self.n_gated_ += 1
-                        self.gated_counts_[idx[worst]] += 1
-                        self.screen_.note([idx[worst]])
-                        keep = np.arange(e.size) != worst
-                        idx, pht, s, e = idx[keep], pht[:, keep], s[np.ix_(keep, keep)], e[keep]
-                        continue
-                w = ui.T @ pht.T  # U^-T H P: gain K = w' U^-T, K S K' = w' w
-                with np.errstate(over="ignore", invalid="ignore"):
-                    x_new = x + w.T @ we
-                if not np.all(np.isfinite(x_new)):  # an update that overflows is no update: keep the prior
-                    self.screen_.note(idx, "range")
-                    self.gated_counts_[idx] += 1
-                    break
-                x = x_new
-                p = p - w.T @ w
-                p = 0.5 * (p + p.T)
-                updated = True
-                break
-        if not updated:
+        if gating and self._gate_run >= self._drift_samples:
+            # the gate has left the filter with at most half of its live channels for _DRIFT_S: not sensor faults
+            # (they hit a minority of channels) but the model's prediction drifting away from all of them. Forget
+            # what the prediction claims to know (add the stationary covariance) and use every live channel.
+            self.n_drift_ += 1
+            self._gate_run = 0
+            p = p + self._P0
+            gating = False
+        x_new, p_new, idx = self._assimilate(x, p, y, live, uk, gate if gating else None)
+        hx, var = self._H @ x_new, (self._H @ p_new * self._H).sum(axis=1)
+        if not self._in_bounds(hx, var):
+            # diverged (an estimate or its std beyond _DIVERGED_Z training stds): restart from the stationary prior
+            # and assimilate the sample again, without the gate; a diverged estimate is never returned
+            self.n_resets_ += 1
+            if self.n_resets_ == 1:
+                warnings.warn(
+                    f"KalmanSensor: the filter diverged at sample {self._n_seen} of this stream (an estimate or its "
+                    f"standard deviation beyond {_DIVERGED_Z:g} training standard deviations) and was restarted "
+                    "from its stationary prior; the model does not match the data. Restarts are counted in "
+                    "n_resets_.", RuntimeWarning, stacklevel=2)
+            x_new, p_new, idx = self._assimilate(np.zeros_like(x), self._P0.copy(), y, live, uk, None)
+            hx, var = self._H @ x_new, (self._H @ p_new * self._H).sum(axis=1)
+            if not self._in_bounds(hx, var):  # not even one sample from the prior: report the prior
+                x_new, p_new, idx = np.zeros_like(x), self._P0.copy(), None
+                hx, var = np.zeros_like(hx), self._prior_var.copy()
+        if idx is None:
             self.n_blind_ += 1
             idx = np.zeros(0, dtype=int)
-        hx = self._H @ x
+        x, p = x_new, p_new
         if uk is not None:
             hx = hx + self._Dk @ uk
         est = self.mean_ + self.scale_ * hx
-        hp = self._H @ p
-        own = np.sqrt(np.maximum((hp * self._H).sum(axis=1), 0.0)) * self.scale_
+        own = np.sqrt(np.maximum(var, 0.0)) * self.scale_
         std = unmeasured_std(own, self._k, self._err_std)
         std[idx] = own[idx]  # channels used at this sample: the filter's own uncertainty
         self.std_ = std
@@ -859,6 +978,135 @@ class KalmanSensor:
         if return_std:
             return est, self.std_.copy()
         return est
+
+    def _assimilate(self, x: np.ndarray, p: np.ndarray, y: np.ndarray, live: np.ndarray, uk: np.ndarray | None,
+                    gate: float | None) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """Kalman update of the prior (x, p) with the live channels of y, gated at ``gate`` (None: no gate).
+
+        Returns the posterior (x, p) and the channels used, or the prior and None if no channel was used (none live,
+        every one gated, or no update possible). Counts gate rejections and keeps the gate's run of samples at which
+        it rejected at least half of the live channels (the model-drift signal of :meth:`update`).
+        """
+        if not live.any():
+            return x, p, None
+        idx, h, r = self._rows_for(live)
+        n_live = idx.size
+        z = (y[idx] - self.mean_[idx]) / self.scale_[idx]
+        if uk is not None:
+            z = z - self._Dk[idx] @ uk
+        pht = p @ h.T
+        s = h @ pht
+        s.flat[:: s.shape[0] + 1] += r
+        e = z - h @ x
+        extra = self._gate_var[idx].copy()
+        k2, r_idx = self._k[idx] ** 2, self._r[idx].copy()
+        ms = self._gate_ms[idx].copy()
+        soft = np.zeros(idx.size, dtype=bool)  # channels down-weighted at this sample
+        repaired = False
+        used = None
+        adapt = None
+        while e.size:
+            chol = _inv_chol(s)  # S = U'U, ui = U^-1, S^-1 = ui ui'
+            if chol is None:
+                if repaired:
+                    break
+                # rounding has made P indefinite: use its nearest positive semidefinite matrix and try again
+                repaired = True
+                p = _nearest_psd(p)
+                h = self._H[idx]
+                pht = p @ h.T
+                s = h @ pht
+                s.flat[:: s.shape[0] + 1] += self._r[idx]
+                continue
+            ui = chol[0]
+            we = ui.T @ e
+            if gate is not None:
+                # leave-one-out residual of each channel in standard deviations: the channel against the prediction
+                # from the prior *and the other channels*, (S^-1 e)_i / (S^-1)_ii, over its standard deviation: the
+                # filter's, 1 / sqrt((S^-1)_ii), with the calibrated unmodelled error added as a variance
+                with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                    sinv_ii = np.einsum("ij,ij->i", ui, ui)
+                    resid = np.abs(ui @ we) / sinv_ii
+                    loo = resid / np.sqrt(ms * _gate_variance(1.0 / sinv_ii, r_idx, k2, extra))
+                if adapt is None:  # every live channel's residual and its filter variance, before any rejection
+                    adapt = (idx, resid, 1.0 / sinv_ii, loo.copy())
+                loo = np.where(np.isnan(loo), np.inf, loo)  # an overflowed residual is an outlier, not NaN
+                # an outlier also surprises the prior: a channel within the gate of its own prior prediction
+                # is what the model expects of it, whatever the others say (see Notes)
+                with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                    prior = np.abs(e) / np.sqrt(ms * _gate_variance(np.diagonal(s), r_idx, k2, extra))
+                loo = np.where(np.isnan(prior) | (prior > gate), loo, 0.0)
+                worst = int(np.argmax(loo))
+                if loo[worst] > _HARD_GATE * gate:  # an outlier: reject it
+                    self.n_gated_ += 1
+                    self.gated_counts_[idx[worst]] += 1
+                    self.screen_.note([idx[worst]])
+                    keep = np.arange(e.size) != worst
+                    idx, pht, s, e = idx[keep], pht[:, keep], s[np.ix_(keep, keep)], e[keep]
+                    extra, k2, r_idx, soft, ms = extra[keep], k2[keep], r_idx[keep], soft[keep], ms[keep]
+                    continue
+                loo = np.where(soft, 0.0, loo)
+                worst = int(np.argmax(loo))
+                if loo[worst] > gate:  # a doubtful value: down-weight it to the gate (Huber), once per sample
+                    add = ms[worst] * _gate_variance(s[worst, worst], r_idx[worst], k2[worst], extra[worst]) * (
+                        (loo[worst] / gate) ** 2 - 1.0)
+                    s[worst, worst] += add
+                    r_idx[worst] += add
+                    soft[worst] = True
+                    self.n_downweighted_ += 1
+                    continue
+            w = ui.T @ pht.T  # U^-T H P: gain K = w' U^-T, K S K' = w' w
+            with np.errstate(over="ignore", invalid="ignore"):
+                x_new = x + w.T @ we
+            if not np.all(np.isfinite(x_new)):  # an update that overflows is no update: keep the prior
+                self.screen_.note(idx, "range")
+                self.gated_counts_[idx] += 1
+                break
+            x = x_new
+            p = p - w.T @ w
+            p = 0.5 * (p + p.T)
+            used = idx
+            break
+        if gate is not None:
+            n_used = 0 if used is None else used.size
+            self._gate_run = self._gate_run + 1 if 2 * n_used <= n_live else 0
+            if adapt is not None:
+                self._adapt_gate(*adapt, gate)
+        return x, p, used
+
+    def _adapt_gate(self, idx: np.ndarray, resid: np.ndarray, var: np.ndarray, loo: np.ndarray, gate: float) -> None:
+        """Running estimate of the unmodelled error variance of each live channel (z-units), for the gate.
+
+        The excess of the squared leave-one-out residual over the filter's variance of it, ``d^2 - v``, averages to
+        the variance the model does not know about. It is averaged exponentially (time constant ``_GATE_TAU_S``)
+        with each sample's contribution capped at ``gate^2`` times the current residual variance, so that a spike
+        moves it by little, and it never falls below the calibration's. On a mismatched model the error grows with
+        the response: trained at 8 and 12 m/s and tested at 18 m/s on OpenFAST records, a gate with the training
+        calibration alone kept rejecting a third of the live accelerometers for minutes.
+
+        Likewise the mean square of the gate's standardised residuals ``loo`` (1 for a right model) is averaged,
+        each sample's value capped at ``gate^2``, and kept >= 1: it scales the gate's variances, so that a model
+        whose errors run at twice what the calibration says gets a gate twice as wide, in whatever pattern of lost
+        channels (with many lost, the filter's part of the variance dominates and the additive estimate alone does
+        not follow).
+        """
+        with np.errstate(over="ignore", invalid="ignore"):
+            z2 = np.minimum(loo * loo, gate * gate)
+        z2 = np.where(np.isnan(z2), gate * gate, z2)
+        ms = self._gate_ms[idx]
+        self._gate_ms[idx] = np.maximum(ms * (1.0 + self._gate_rate * (z2 - 1.0)), 1.0)
+        g = self._gate_var[idx]
+        with np.errstate(over="ignore", invalid="ignore"):
+            excess = np.minimum(resid * resid - var, gate * gate * (var + g))
+        excess = np.where(np.isfinite(excess), excess, gate * gate * (var + g))
+        g = g + self._gate_rate * (excess - g)
+        self._gate_var[idx] = np.maximum(g, self._gate_var0[idx])
+
+    def _in_bounds(self, hx: np.ndarray, var: np.ndarray) -> bool:
+        """False if an estimate ``hx`` or its variance ``var`` (z-units) is beyond ``_DIVERGED_Z`` training stds (or
+        not finite): the filter has diverged."""
+        with np.errstate(invalid="ignore"):
+            return bool(np.all(np.abs(hx) <= self._z_limit) and np.all(var <= self._z_limit**2))
 
     def reconstruct(self, Y, mask=None, *, U=None, return_std: bool = False):
         """Estimate a whole record by streaming it through :meth:`update` after a :meth:`reset`.
@@ -1045,6 +1293,21 @@ class _ExactFilter:
 
 
 # ------------------------------------------------------------------------------------------------- helpers
+def _gate_variance(v: np.ndarray, r: np.ndarray, k2: np.ndarray, extra: np.ndarray) -> np.ndarray:
+    """Variance the innovation gate allows a residual whose filter variance is ``v`` (z-units): the larger of the
+    filter's part scaled by the calibration factor squared ``k2`` (plus the noise ``r``) and ``v`` plus the
+    unmodelled error variance ``extra``. The scaled form grows with the filter's uncertainty (many channels lost),
+    the additive one carries the running estimate of the unmodelled error."""
+    return np.maximum(k2 * np.maximum(v - r, 0.0) + r, v + extra)
+
+
+def _nearest_psd(p: np.ndarray) -> np.ndarray:
+    """The symmetric positive semidefinite matrix nearest to ``p`` (negative eigenvalues raised to a tiny floor)."""
+    w, v = np.linalg.eigh(0.5 * (p + p.T))
+    w = np.maximum(w, 1e-12 * max(float(np.abs(w).max()), 1e-300))
+    return (v * w) @ v.T
+
+
 def _positive_float(value, name: str) -> float:
     try:
         v = float(value)

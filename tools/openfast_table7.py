@@ -6,10 +6,10 @@ tower channels (``TwHt1..9ALxt``, ``TwHt1..9MLyt``), under the paper's scenarios
 (20 %, 2 s bursts). Sensors: look-ahead Hankel-DMD (the paper's Algorithm 1, an offline smoother:
 ``HankelDMDSensor(causal=False)``), causal Hankel-DMD (1 s recalibration), the Kalman filter on the surrogate's
 linearisation at the test run's operating point (from its ``case.json`` sidecar; gauges at the OpenFAST deck's
-heights) -- a *mismatched* model, as on a real turbine -- in three variants (compare's default: load levels learned
-on the training runs and the innovation gate; without the gate; the surrogate's nominal load levels without the
-gate), the Koopman-Kalman filter (a Kalman filter on the
-Hankel-DMD model: data only) and hold-last-value.
+heights) -- a *mismatched* model, as on a real turbine -- in three variants (compare's default: load levels by
+likelihood on the training runs, the nominal ones where the likelihood does not identify them, and the innovation
+gate; the same without the gate; the surrogate's nominal load levels without the gate), the Koopman-Kalman
+filter (a Kalman filter on the Hankel-DMD model: data only) and hold-last-value.
 
 Writes ``OUT/fold_<run>.json`` (``fowt-env compare --json`` of each fold), ``OUT/table7.json`` (the aggregates)
 and ``OUT/table7.md`` (the README tables). Run from the repository root::
@@ -37,8 +37,8 @@ import numpy as np
 
 RUNS = ("c_op08_Hs2p0_Tp9", "c_op12_Hs2p5_Tp10", "c_op18_Hs4p0_Tp11")
 LABELS = {"dmd_lookahead": "look-ahead DMD (offline smoother)", "dmd": "causal DMD, 1 s",
-          "kalman": "Kalman (default: learned load levels, innovation gate)",
-          "kalman_nogate": "Kalman (learned load levels, no gate)",
+          "kalman": "Kalman (compare's default, innovation gate)",
+          "kalman_nogate": "Kalman (compare's default, no gate)",
           "kalman_nominal": "Kalman (nominal load levels, no gate)",
           "koopman": "Koopman-Kalman (DMD model)",
           "hold": "hold last value"}
@@ -65,7 +65,8 @@ def _register_lookahead() -> None:
     def kalman_nominal(dt: float, update_interval: float | None, *, channels: Any = None, **options: Any) -> Any:
         """The Kalman filter with the surrogate's nominal load levels at the operating point (``process_noise=1``)
         instead of load levels learned from the training runs (which are at other operating points), and no
-        innovation gate (under a mismatched model the gate rejects good channels and the filter runs away)."""
+        innovation gate: the reference for the default (before its fixes, the default's likelihood search picked
+        levels thousands of times the nominal and its gate cut it off from its live channels)."""
         return C._kalman(dt, update_interval, channels=channels, process_noise=1.0, gate_sigma=None, **options)
 
     def kalman_nogate(dt: float, update_interval: float | None, *, channels: Any = None, **options: Any) -> Any:
