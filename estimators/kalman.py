@@ -875,6 +875,7 @@ class KalmanSensor:
         # divergence limit (z-units): _DIVERGED_Z, or 10 stationary stds of a model given implausibly wide loads
         self._prior_var = np.maximum(np.einsum("ij,jk,ik->i", self._H, self._P0, self._H), 0.0)
         self._z_limit = np.maximum(_DIVERGED_Z, 10.0 * np.sqrt(self._prior_var))
+        self._z_limit2 = self._z_limit**2
         self.std_ = unmeasured_std(
             np.sqrt(np.einsum("ij,jk,ik->i", self._H, self._P, self._H)) * self.scale_, self._k, self._err_std)
         self.input_estimate_ = np.zeros(len(self._iu))
@@ -1090,23 +1091,21 @@ class KalmanSensor:
         channels (with many lost, the filter's part of the variance dominates and the additive estimate alone does
         not follow).
         """
-        with np.errstate(over="ignore", invalid="ignore"):
-            z2 = np.minimum(loo * loo, gate * gate)
+        z2 = np.minimum(loo, gate) ** 2  # clipped before squaring: no overflow
         z2 = np.where(np.isnan(z2), gate * gate, z2)
         ms = self._gate_ms[idx]
         self._gate_ms[idx] = np.maximum(ms * (1.0 + self._gate_rate * (z2 - 1.0)), 1.0)
         g = self._gate_var[idx]
-        with np.errstate(over="ignore", invalid="ignore"):
-            excess = np.minimum(resid * resid - var, gate * gate * (var + g))
-        excess = np.where(np.isfinite(excess), excess, gate * gate * (var + g))
+        cap = gate * gate * (var + g)
+        excess = np.minimum(resid, np.sqrt(cap + var)) ** 2 - var  # = min(resid^2 - var, cap), without overflow
+        excess = np.where(np.isfinite(excess), excess, cap)
         g = g + self._gate_rate * (excess - g)
         self._gate_var[idx] = np.maximum(g, self._gate_var0[idx])
 
     def _in_bounds(self, hx: np.ndarray, var: np.ndarray) -> bool:
         """False if an estimate ``hx`` or its variance ``var`` (z-units) is beyond ``_DIVERGED_Z`` training stds (or
         not finite): the filter has diverged."""
-        with np.errstate(invalid="ignore"):
-            return bool(np.all(np.abs(hx) <= self._z_limit) and np.all(var <= self._z_limit**2))
+        return bool((np.abs(hx) <= self._z_limit).all() and (var <= self._z_limit2).all())  # NaN: False
 
     def reconstruct(self, Y, mask=None, *, U=None, return_std: bool = False):
         """Estimate a whole record by streaming it through :meth:`update` after a :meth:`reset`.
