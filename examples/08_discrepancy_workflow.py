@@ -37,11 +37,8 @@ What to look for.
 * Try ``--hide aero_damping``: the effect also carries the rotor's aerodynamic damping of the tower, so hiding it
   leaves a strong signature -- far less power in the 2nd tower band of the tower-base moment and tower-top
   acceleration than the candidate has (z about -14) and shifted tower-mode centroid frequencies (z -17 to +9).
-  ``--quick`` names it at 1.14 (0.88 to 1.22; gap 16.8 -> 1.5). With every candidate, ten minutes name it at 1.18
-  and then add the tower's fore-aft stiffness at 1.03 (1.01 to 1.04), which the truth does not have: the greedy
-  second round fits what the first left over, on a record shorter than the 20 minutes the workflow is verified
-  on -- and the report warns that the record is short. On 20 minutes, among a few decoys, the hidden-truth test
-  names ``aero_damping`` alone (0.85, 0.77 to 1.18). Or ``--hide quadratic_drag``: at this wind speed
+  Ten minutes name it at 1.06 (0.87 to 1.30; gap 16.8 -> 1.3; ``--quick``: 1.14, 0.88 to 1.22), the hidden-truth
+  test on 20 minutes among a few decoys at 0.85 (0.77 to 1.18). Or ``--hide quadratic_drag``: at this wind speed
   aerodynamic damping dominates the platform's damping, drag is not detectable from these channels, and "no significant
   discrepancy" is the honest answer -- a limit of the data, not of the method.
 

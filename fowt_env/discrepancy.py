@@ -732,7 +732,19 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
             if c.kind == "switch":
                 interval = (fit["value"], fit["value"])
             else:
-                _, _, interval = _extend(c, current, points, gap_with(own), own.accept, ev, seeds)
+                best_own, _, interval = _extend(c, current, points, gap_with(own), own.accept, ev, seeds)
+                if interval is not None and gap_with(own)(own.mean) > own.accept and abs(best_own - fit["value"]) > 0:
+                    # judged with its own scatter the fitted value is not accepted but others are (the profile's
+                    # minimum moves with the scale): refit at the own-scale best and judge that model by its own
+                    # seeds -- else a greedy next round fits what is left over (a spurious second candidate)
+                    refit = c.apply(current, best_own)
+                    own2 = _Scale.of(ev.rows(refit, scatter_seeds), meas.kinds, n)
+                    if gap_with(own2)(own2.mean) <= own2.accept:
+                        fit = {**fit, "value": best_own}
+                        fitted, own = refit, own2
+                        points[best_own] = own2.mean
+                        best_own, _, interval = _extend(c, current, points, gap_with(own), own.accept, ev, seeds)
+                        entry.update(strength=fit["value"], refit_own_scale=True)
                 s0 = c.value(current)
                 if interval is not None and interval[0] < s0 < interval[1]:
                     # the profile judges every value with the fitted model's scatter, which may accept the starting
