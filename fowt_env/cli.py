@@ -819,8 +819,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--seed", type=int, default=None,
                    help="first seed of the model simulations (default 1000; the next --seeds - 1 follow)")
     q.add_argument("--replay", action="store_true",
-                   help="compare residual time series under the record's own waves and wind (its Wave1Elev and "
-                        "Wind1VelX channels) instead of statistics against the model's seed scatter")
+                   help="compare residual time series under the record's own waves and wind (its Wave1Elev, and the "
+                        "rotor-effective wind estimated from RotThrust, RotSpeed and BldPitch1 if it has them, else "
+                        "Wind1VelX) instead of statistics against the model's seed scatter")
     q.add_argument("--json", default=None, help="write the report as JSON")
     q.add_argument("--plot", default=None, help="folder for the figure")
     q.set_defaults(func=_cmd_discrepancy)

@@ -37,8 +37,9 @@ how sure is that -- or is it something no candidate explains.
    much one of them reduces the gap.
 5. **With replay** (``replay=True``, :mod:`fowt_env.discrepancy_replay`) -- when the record carries its wave
    elevation and wind (``Wave1Elev``, ``Wind1VelX``), the features are instead the residuals of the measurement
-   against the model replayed under that forcing, per channel and band; the scatter and null come from the
-   model's own records replayed from their own forcing, and steps 2-4 apply unchanged.
+   against the model replayed under that forcing (the wind: the rotor-effective wind estimated from the rotor's
+   thrust, speed and pitch when the record has them, :mod:`fowt_env.wind_estimate`), per channel and band; the
+   scatter and null come from the model's own records replayed the same way, and steps 2-4 apply.
 6. **Record length** -- the answers are verified by hidden-truth tests on 20-minute records
    (:data:`RELIABLE_DURATION`); a shorter record gets a warning in the report (intervals widen as the scatter
    grows; below 10 minutes the platform band holds only a few Welch segments).
@@ -196,6 +197,9 @@ class DiscrepancyReport:
     mode : {"statistics", "replay"}
         Which features were compared: statistics against the model's seed scatter, or residuals against the
         model replayed under the record's own waves and wind (:mod:`fowt_env.discrepancy_replay`).
+    replay_wind : {"rotor", "hub"} or None
+        In replay mode, the wind replayed: the rotor-effective wind estimated from the rotor's thrust, speed and
+        pitch (:mod:`fowt_env.wind_estimate`) or the hub wind ``Wind1VelX``.
     effect : str or None
         The first named candidate (an effect or a parameter), None unless the verdict is "explained".
     strength : float or None
@@ -274,11 +278,14 @@ class DiscrepancyReport:
     case: LoadCase
     alternatives: list[dict] = field(default_factory=list)
     mode: str = "statistics"
+    replay_wind: str | None = None
     _spectra: dict = field(default_factory=dict, repr=False)
 
     def summary(self) -> str:
         """A few lines for people."""
-        lines = ["replay mode: residuals of the measurement against the model driven by its own waves and wind"
+        wind = {"rotor": "rotor-effective wind estimated from its thrust, speed and pitch",
+                "hub": "hub wind"}.get(self.replay_wind or "", "wind")
+        lines = [f"replay mode: residuals of the measurement against the model driven by its own waves and {wind}"
                  ] if self.mode == "replay" else []
         lines += [f"gap before: {self.gap_before:.2f}  (null level {self.null_gap:.2f}; significant above "
                  f"{self.detect_gap:.2f}, explained at or below {self.accept_gap:.2f})"]
@@ -318,7 +325,8 @@ class DiscrepancyReport:
     def to_dict(self) -> dict:
         """JSON-friendly form (without the model object: its description instead)."""
         return {
-            "verdict": self.verdict, "mode": self.mode, "effect": self.effect, "strength": self.strength,
+            "verdict": self.verdict, "mode": self.mode, "replay_wind": self.replay_wind, "effect": self.effect,
+            "strength": self.strength,
             "effects": [list(e) for e in self.effects], "fits": self.fits, "at_bound": self.at_bound,
             "gap_before": self.gap_before, "gap_after": self.gap_after, "null_gap": self.null_gap,
             "accept_gap": self.accept_gap, "detect_gap": self.detect_gap,
@@ -479,7 +487,7 @@ def run(
     progress: bool | None = False,
     n_screen: int = 2,
     n_refine: int = 3,
-    replay: bool = False,
+    replay: bool | str = False,
 ) -> DiscrepancyReport:
     """Find where a model and a measured record disagree and which named effect or parameter explains it.
 
@@ -520,10 +528,12 @@ def run(
         Seeds of the screening probe of every candidate (1 to n_seeds).
     n_refine : int
         Candidates profiled per greedy round (the best-screened ones).
-    replay : bool
+    replay : bool or {"rotor", "hub"}
         Compare residual time series under the record's own forcing instead of statistics
         (:mod:`fowt_env.discrepancy_replay`): the record must carry ``Wave1Elev`` (m) and ``Wind1VelX`` (m/s);
-        the model is replayed at the record's sample time (``sim_dt`` is not used).
+        the model is replayed at the record's sample time (``sim_dt`` is not used). True replays the
+        rotor-effective wind estimated from the record's rotor thrust, speed and pitch when it has those channels
+        (``"rotor"``), else the hub wind (``"hub"``); a string forces one.
 
     Returns
     -------
@@ -561,7 +571,7 @@ def run(
         return discrepancy_replay.run(measured, model, case, seed=seed, names=names, n_seeds=int(n_seeds),
                                       strengths=strengths, max_effects=int(max_effects), channels=channels,
                                       n_scatter=int(n_scatter), progress=progress, n_screen=int(n_screen),
-                                      n_refine=int(n_refine))
+                                      n_refine=int(n_refine), wind="auto" if replay is True else str(replay))
     meas = features(measured, case, channels)
     dt = max(measured.dt, FAST_DT) if sim_dt is None else float(sim_dt)
     base = as_parametric(model)
@@ -651,7 +661,8 @@ class _Scale:
 
 def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: LoadCase, cands: list[_Candidate],
             max_effects: int, n_refine: int, meas: FeatureSet, seeds: list[int], scatter_seeds: list[int],
-            screen_seeds: list[int], ev: _Evaluator) -> tuple[DiscrepancyReport, ParametricModel]:
+            screen_seeds: list[int], ev: _Evaluator, prefer_inside: bool = False
+            ) -> tuple[DiscrepancyReport, ParametricModel]:
     """:func:`run`'s screening, profiles and greedy selection; returns the report and the final model as simulated
     (the candidate, with the noise of the simulations, plus what was named).
 
@@ -714,6 +725,12 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
                             "interval": fit["interval"], "at_bound": fit["at_bound"]})
                 fits.append((fit["gap"], len(fits), c, fit, log[-1]))
             g, _, c, fit, entry = min(fits)
+            inside = [x for x in fits if x[3]["at_bound"] is None and x[0] <= ref.accept]
+            if prefer_inside and fit["at_bound"] is not None and inside:
+                # replay mode: a fit inside its range that the level accepts is preferred to one at the bound; the
+                # bound is reported beside it (the features cannot tell the two apart)
+                bounded.append({"name": c.name, "bound": fit["value"], "side": fit["at_bound"], "gap": g})
+                g, _, c, fit, entry = min(inside)
             bic = n_f * math.log(g_cur / max(g, 1e-12)) > math.log(n_f) + 2.0
             significant = _improves(g_cur, g, n_f)
             if fit["at_bound"] is not None and bic:  # it points beyond its range: a bound, never a value
