@@ -162,6 +162,7 @@ def test_replay_names_a_missing_quadratic_drag_at_rated_wind():
 
 
 @pytest.mark.slow
+@pytest.mark.matrix
 def test_a_drag_coefficient_of_one_and_a_half_is_never_misnamed_with_replay():
     """Truth: ``drag_cd`` x1.5 (OLC 10, Hs 4 m); the candidate is nominal. Not found (gap 0.84 against a level of
     2.72, as the statistics: 1.18 against 2.56); never a decoy either."""
@@ -187,6 +188,7 @@ def test_replay_names_an_added_mass_ten_percent_high_that_the_statistics_miss():
 
 
 @pytest.mark.slow
+@pytest.mark.matrix
 def test_cli_replay_on_the_packaged_openfast_run(tmp_path, capsys):
     out = tmp_path / "rep.json"
     code = main(["discrepancy", str(OPENFAST_RUN), "--replay", "--candidates", "added_mass,drag_cd",
