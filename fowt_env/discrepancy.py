@@ -750,7 +750,7 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
                 interval = (fit["value"], fit["value"])
             else:
                 best_own, _, interval = _extend(c, current, points, gap_with(own), own.accept, ev, seeds)
-                if interval is not None and gap_with(own)(own.mean) > own.accept and abs(best_own - fit["value"]) > 0:
+                if interval is not None and gap_with(own)(own.mean) > own.accept and best_own != fit["value"]:
                     # judged with its own scatter the fitted value is not accepted but others are (the profile's
                     # minimum moves with the scale): refit at the own-scale best and judge that model by its own
                     # seeds -- else a greedy next round fits what is left over (a spurious second candidate)
@@ -760,7 +760,7 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
                         fit = {**fit, "value": best_own}
                         fitted, own = refit, own2
                         points[best_own] = own2.mean
-                        best_own, _, interval = _extend(c, current, points, gap_with(own), own.accept, ev, seeds)
+                        _, _, interval = _extend(c, current, points, gap_with(own), own.accept, ev, seeds)
                         entry.update(strength=fit["value"], refit_own_scale=True)
                 s0 = c.value(current)
                 if interval is not None and interval[0] < s0 < interval[1]:
@@ -771,8 +771,7 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
             entry.update(accepted=True, own_gap=gap_with(own)(own.mean), own_accept=own.accept)
             alternatives += [
                 {"name": c2.name, "kind": c2.kind, "value": float(f2["value"]), "interval": list(f2["interval"]),
-                 "interval_at_bound": [bool(f2["interval"][0] <= c2.lo + 1e-6 * (c2.hi - c2.lo)),
-                                       bool(f2["interval"][1] >= c2.hi - 1e-6 * (c2.hi - c2.lo))],
+                 "interval_at_bound": _at_bound(f2["interval"], (c2.lo, c2.hi)),
                  "gap": float(g2), "instead_of": c.name}
                 for g2, _, c2, f2, _ in fits
                 if c2 is not c and f2["at_bound"] is None and f2["interval"] is not None and g2 <= ref.accept
@@ -796,9 +795,8 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
     fits_out = []
     for c, v, interval, bounds in named:
         lo, hi = interval if interval is not None else (v, v)
-        eps = 1e-6 * (bounds[1] - bounds[0])
         fits_out.append({"name": c.name, "kind": c.kind, "value": float(v), "interval": [lo, hi],
-                         "interval_at_bound": [bool(lo <= bounds[0] + eps), bool(hi >= bounds[1] - eps)],
+                         "interval_at_bound": _at_bound((lo, hi), bounds),
                          "bounds": list(bounds), "excludes_start": open_at.get(c.name)})
     for b in bounded:
         warnings.append(f"{b['name']}: the best fit lies at the edge of its search range ({b['side']} bound "
@@ -815,6 +813,12 @@ def _search(measured: Record, model: FOWTModel, base: ParametricModel, case: Loa
         warnings=warnings, duration=float(measured.duration), n_simulations=0, updated_model=updated, case=case,
         alternatives=alternatives)
     return report, current
+
+
+def _at_bound(interval: Sequence[float], bounds: Sequence[float]) -> list[bool]:
+    """Whether each end of an interval reaches the search range's edge (to 1e-6 of the range)."""
+    eps = 1e-6 * (bounds[1] - bounds[0])
+    return [bool(interval[0] <= bounds[0] + eps), bool(interval[1] >= bounds[1] - eps)]
 
 
 def _improves(g_old: float, g_new: float, n_features: int) -> bool:
