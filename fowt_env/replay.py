@@ -66,7 +66,7 @@ SEGMENT_S = 100.0
 """Welch segment length (s) of the coherence bound: 0.01 Hz resolution, ~10 averages over a 600 s record."""
 
 _INITIAL_CHANNELS = ("PtfmSurge", "PtfmSway", "PtfmHeave", "PtfmRoll", "PtfmPitch", "PtfmYaw", "TTDspFA", "TTDspSS",
-                     "RotSpeed", "Azimuth")
+                     "RotSpeed", "Azimuth", "BldPitch1", "GenTq")
 
 
 # -------------------------------------------------------------------------------------------- statistics
@@ -187,7 +187,9 @@ def _initial_rate(t: NDArray[np.float64], x: NDArray[np.float64]) -> float | Non
 
 def record_initial(record: Any) -> dict[str, float]:
     """Initial conditions (OpenFAST names and units) from a record's first sample: platform DOFs, tower-top
-    deflections, rotor speed and azimuth, those the record has, and the platform DOFs' rates -- the record's
+    deflections, rotor speed and azimuth, the controller's pitch and generator torque (a controller started from
+    its steady state instead drifts by half a revolution of azimuth in the first 50 s of OpenFAST's 18 m/s run,
+    which no later sample recovers), those the record has, and the platform DOFs' rates -- the record's
     ``PtfmTVxi`` ... ``PtfmRVzi`` if it has them, else the slope of a quadratic fitted to the first
     :data:`RATE_FIT_S` seconds of the position. Without the rates a replay would start the slow modes from rest:
     the 124 s surge mode then takes minutes to forget it (OpenFAST's 18 m/s run: surge R² over 200-450 s -1.5)."""
@@ -278,8 +280,8 @@ def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: A
         raise ValueError("the record has neither a wave elevation (Wave1Elev) nor a wind (Wind1VelX) to replay")
     init = record_initial(record) if initial else None
     if init and lc.wind_speed <= 0:
-        init.pop("RotSpeed", None)
-        init.pop("Azimuth", None)
+        for name in ("RotSpeed", "Azimuth", "BldPitch1", "GenTq"):
+            init.pop(name, None)
     return surrogates.simulate(model, lc, dt=dt, seed=seed, transient=transient, noise=False, initial=init,
                                waves=waves_in, wind=wind_in, on_progress=on_progress)
 

@@ -328,7 +328,10 @@ class ReplaySource:
         name = str(self.path) if self.path is not None else "record"
         elev_mean, wind_mean = (float(v) for v in scan.sums / scan.n)
         self.waves = StreamedWaves(series, column=0, mean=elev_mean, ends=(scan.heads[0], scan.tails[0]))
-        self.wind = StreamedWind(series, "hub", hub_column=1, mean=wind_mean, ends=(scan.heads[1], scan.tails[1]))
+        # the record's Wind1VelX: at a fixed point at x = 0 (OpenFAST), or at the rotor (a surrogate's own record)
+        x_ref = None if self._source == "surrogates.simulate" else 0.0
+        self.wind = StreamedWind(series, "hub", hub_column=1, mean=wind_mean, ends=(scan.heads[1], scan.tails[1]),
+                                 x_ref=x_ref)
         if wind is None and self.path is not None:
             wind = _sidecar(self.path, ".inflow.npz")
         if wind is not None and not (isinstance(wind, str) and wind == "record"):
@@ -360,6 +363,7 @@ class ReplaySource:
         with zipfile.ZipFile(path) as z, z.open("header.npy") as fh:
             header = json.loads(str(np.lib.format.read_array(fh, allow_pickle=False)[()]))
         channels = list(header.get("channels", []))
+        self._source = (header.get("meta") or {}).get("source")
         missing = [c for c in ("Wave1Elev", "Wind1VelX") if c not in channels]
         if missing:
             raise ValueError(f"replay: {path} has no {' and no '.join(missing)} channel (a replay needs the measured "
@@ -386,6 +390,7 @@ class ReplaySource:
         return series, scan
 
     def _scan_memory(self, rec: Any) -> tuple[ArraySeries, _Scan]:
+        self._source = (getattr(rec, "meta", None) or {}).get("source")
         missing = [c for c in ("Wave1Elev", "Wind1VelX") if c not in rec.channels]
         if missing:
             raise ValueError(f"replay: the record has no {' and no '.join(missing)} channel (a replay needs the "
@@ -514,4 +519,4 @@ def _given_wind(wind: MeasuredWind) -> StreamedWind:
         data = np.hstack([data, np.asarray(wind.blade, float)])
     dt = float(np.median(np.diff(wind.t)))
     return StreamedWind(ArraySeries(float(wind.t[0]), dt, data), "given", hub_column=0, effective_column=1,
-                        shear_columns=shear, field_columns=blade)
+                        shear_columns=shear, field_columns=blade, x_ref=wind.x_ref)

@@ -196,8 +196,19 @@ def steady_state(aero_torque, wind_speed: float, gearbox_ratio: float = 97.0) ->
     return SteadyState(float(wind_speed), float(omega), fine, float(tq), _region(n * omega, fine))
 
 
-def initial_controller_state(gen_speed: float, pitch: float) -> np.ndarray:
-    """Controller state as the DLL initialises it on its first call (filtered speed = speed, the integrator
-    set so that the pitch is unchanged at zero speed error, last torque = the law's value)."""
+def initial_controller_state(gen_speed: float, pitch: float, torque: float | None = None) -> np.ndarray:
+    """Controller state as the DLL initialises it on its first call: filtered speed = ``gen_speed`` (rad/s, HSS),
+    pitch = ``pitch`` (rad), the speed-error integrator set so that the PI command equals that pitch at the
+    present speed error (its proportional part included, within the DLL's integrator limits; at the minimum
+    pitch the integrator rests on its lower limit, as below rated), last torque =
+    ``torque`` (N·m, HSS; default the torque law's value).
+
+    Starting from a measured sample (pitch and torque of a record) the controller then continues as the
+    record's did instead of from its steady state.
+    """
     gk = 1.0 / (1.0 + pitch / DISCON["PC_KK"])
-    return np.array([gen_speed, pitch / (gk * DISCON["PC_KI"]), pitch, generator_torque_law(gen_speed, pitch)])
+    err = gen_speed - DISCON["PC_RefSpd"]
+    integ = (pitch / gk - DISCON["PC_KP"] * err) / DISCON["PC_KI"] if pitch > DISCON["PC_MinPit"] + 1e-9 else 0.0
+    integ = min(max(integ, DISCON["PC_MinPit"] / (gk * DISCON["PC_KI"])), DISCON["PC_MaxPit"] / (gk * DISCON["PC_KI"]))
+    tq = generator_torque_law(gen_speed, pitch) if torque is None else float(torque)
+    return np.array([gen_speed, integ, pitch, tq])

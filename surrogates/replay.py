@@ -78,6 +78,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "MIN_RECORD_SECONDS",
+    "advection_delay",
     "MeasuredWaves",
     "MeasuredWind",
     "as_measured_waves",
@@ -417,6 +418,13 @@ class MeasuredWind:
     level : str
         ``"hub"``, ``"rotor_effective"`` or ``"field"``.
     source : str
+    x_ref : float or None
+        Downwind position (m, inertial frame, from the platform's undisplaced axis) of the plane where the wind
+        was measured; default 0: OpenFAST's convention (``Wind1VelX`` at (0, 0, hub height), the TurbSim field
+        passing x = 0 at its own time). The replay carries it to the rotor's mean position by Taylor's frozen
+        turbulence: it reaches the rotor ``(x_rotor - x_ref) / U`` later (:func:`advection_delay`; ~1.9 s at
+        12 m/s, where the rotor sits ~21 m downwind of x = 0). None: measured at the moving rotor (a rotor
+        wind estimate, a spinner anemometer or a lidar referenced to the rotor): no delay.
     """
 
     t: np.ndarray
@@ -427,8 +435,11 @@ class MeasuredWind:
     blade: np.ndarray | None = None
     level: str = "rotor_effective"
     source: str = ""
+    x_ref: float | None = 0.0
 
     def __post_init__(self) -> None:
+        if self.x_ref is not None and not np.isfinite(self.x_ref):
+            raise ValueError(f"wind: x_ref must be a finite position (m) or None, got {self.x_ref!r}")
         t, hub, _ = _time_series("wind", self.t, self.hub)
         _, eff, _ = _time_series("wind (rotor-effective)", t, self.rotor_effective)
         object.__setattr__(self, "t", t)
@@ -450,7 +461,8 @@ class MeasuredWind:
 
     @classmethod
     def from_hub(cls, t: np.ndarray, hub: np.ndarray, *, shear_exponent: float = 0.2, hub_height: float = 90.0,
-                 radius: float = 63.0, taper_s: float = DEFAULT_TAPER_S, source: str = "") -> MeasuredWind:
+                 radius: float = 63.0, taper_s: float = DEFAULT_TAPER_S, source: str = "",
+                 x_ref: float | None = 0.0) -> MeasuredWind:
         """Hub-height wind (m/s) -> rotor-effective wind through the rotor-averaging (Wiener) filter ``G(f)``.
 
         ``U_eff = A_profile mean(U_hub) + G(f) * (U_hub - mean)``: ``G`` from :func:`surrogates.wind.
@@ -464,20 +476,21 @@ class MeasuredWind:
         eff = _fft_filter(u, dt, lambda f: rotor_averaging(f, v, radius, hub_height)[1][None, :].astype(complex),
                           taper_s)[:, 0]
         eff = eff + v * _profile_disc_mean(alpha, hub_height, radius)
-        return cls(tt, u, eff, level="hub", source=source or "hub-height wind")
+        return cls(tt, u, eff, level="hub", source=source or "hub-height wind", x_ref=x_ref)
 
     @classmethod
     def from_rotor_effective(cls, t: np.ndarray, rotor_effective: np.ndarray, hub: np.ndarray | None = None,
-                             source: str = "") -> MeasuredWind:
-        """A rotor-effective wind series (m/s) given directly; ``hub`` (m/s) for the Wind1VelX channel."""
+                             source: str = "", x_ref: float | None = None) -> MeasuredWind:
+        """A rotor-effective wind series (m/s) given directly; ``hub`` (m/s) for the Wind1VelX channel; ``x_ref``
+        where it was measured (default None: at the rotor, as an estimate from the rotor's own response is)."""
         eff = np.asarray(rotor_effective, dtype=float)
         return cls(np.asarray(t, float), eff if hub is None else np.asarray(hub, float), eff,
-                   level="rotor_effective", source=source or "rotor-effective wind")
+                   level="rotor_effective", source=source or "rotor-effective wind", x_ref=x_ref)
 
     @classmethod
     def from_polar(cls, t: np.ndarray, polar_u: np.ndarray, radii: np.ndarray, azimuth_rad: np.ndarray,
                    hub: np.ndarray | None = None, *, radius: float = 63.0, n_azimuth: int = 24,
-                   source: str = "") -> MeasuredWind:
+                   source: str = "", x_ref: float | None = 0.0) -> MeasuredWind:
         """A streamwise field on a polar rotor grid (n_t, n_radii, n_azimuth), m/s -> disc mean, gradients and
         blade-effective winds; ``hub`` (m/s, default the grid's ring of radius 0)."""
         u = np.asarray(polar_u)
@@ -489,13 +502,20 @@ class MeasuredWind:
             hub = np.asarray(u[:, 0, 0], float)
         blade = blade_effective_wind(u, radii, azimuth_rad, n_azimuth)
         return cls(np.asarray(t, float), np.asarray(hub, float), mean, gy, gz, blade, level="field",
-                   source=source or "polar wind field")
+                   source=source or "polar wind field", x_ref=x_ref)
 
     @classmethod
     def from_record(cls, record: Any, channel: str = "Wind1VelX", **kwargs: Any) -> MeasuredWind:
-        """The hub wind channel of a :class:`surrogates.Record` (OpenFAST ``Wind1VelX``), level ``"hub"``."""
+        """The hub wind channel of a :class:`surrogates.Record` (OpenFAST ``Wind1VelX``), level ``"hub"``.
+
+        Its plane ``x_ref`` (unless given): 0 for an OpenFAST record (a fixed point at x = 0); None for a record
+        of :func:`surrogates.simulate`, whose wind is synthesised at the rotor.
+        """
         if channel not in getattr(record, "channels", ()):
             raise ValueError(f"wind: the record has no {channel!r} channel (hub-height wind, m/s)")
+        meta = getattr(record, "meta", None) or {}
+        if "x_ref" not in kwargs and meta.get("source") == "surrogates.simulate":
+            kwargs["x_ref"] = None
         return cls.from_hub(np.asarray(record.t), np.asarray(record[channel]),
                             source=f"record channel {channel}", **kwargs)
 
@@ -512,17 +532,50 @@ class MeasuredWind:
             t = np.asarray(z["t"], float)
             hub = np.asarray(z["hub_uvw"][:, 0], float)
             src = f"{path} ({level})"
+            # the OpenFAST reference's wind passes the plane x = 0 (Wind1VelX's point) at its time axis
             if level == "hub":
-                return cls.from_hub(t, hub, source=src)
+                return cls.from_hub(t, hub, source=src, x_ref=0.0)
             if level == "rotor_effective":
-                return cls.from_rotor_effective(t, np.asarray(z["disc_mean_u"], float), hub, source=src)
+                return cls.from_rotor_effective(t, np.asarray(z["disc_mean_u"], float), hub, source=src, x_ref=0.0)
             if level == "field":
-                return cls.from_polar(t, z["polar_u"], z["polar_radii"], z["polar_azimuth_rad"], hub, source=src)
+                return cls.from_polar(t, z["polar_u"], z["polar_radii"], z["polar_azimuth_rad"], hub, source=src,
+                                      x_ref=0.0)
         raise ValueError(f"wind: level must be 'hub', 'rotor_effective' or 'field', got {level!r}")
 
     def mean_speed(self) -> float:
         """Mean hub-height wind (m/s)."""
         return float(np.mean(self.hub))
+
+
+def advection_delay(sim: Simulator, wind: MeasuredWind | None = None, *, x_ref: float | None = 0.0,
+                    mean_speed: float | None = None) -> float:
+    """Time (s) the measured wind takes from its plane ``x_ref`` to the rotor (Taylor's frozen turbulence).
+
+    The rotor apex's mean downwind position is taken at the simulator's static equilibrium (mean surge, mean
+    pitch, the tower's mean bending, the overhang); the wind is advected at its mean hub-height speed. The
+    rotor's motion about that mean is left to the hub-relative wind the aerodynamics already use.
+
+    Parameters
+    ----------
+    sim : Simulator
+    wind : MeasuredWind, optional
+        Gives ``x_ref`` and the mean speed; otherwise pass them.
+    x_ref : float or None
+        Plane of the measurement (m downwind); None: at the rotor (delay 0).
+    mean_speed : float, optional
+        Mean hub-height wind (m/s); default ``wind``'s, else the simulator's load case's.
+    """
+    from .structure import N_DOF
+
+    if wind is not None:
+        x_ref, mean_speed = wind.x_ref, wind.mean_speed()
+    if x_ref is None:
+        return 0.0
+    if mean_speed is None:
+        mean_speed = sim.case.wind_speed if sim.case is not None else 0.0
+    st = sim.system.structure
+    x_rotor = float(st.hub_position[0] + st.hub_translation[0] @ sim.x_eq[:N_DOF])
+    return (x_rotor - float(x_ref)) / max(float(mean_speed), 0.1)
 
 
 def as_measured_waves(waves: Any) -> MeasuredWaves:
@@ -611,11 +664,12 @@ def replay_forcing(sim: Simulator, n_steps: int, t_start: float, waves: Measured
     if wind is not None:
         if lc is None or lc.wind_speed <= 0:
             raise ValueError("wind replay needs an operating load case (wind_speed > 0, e.g. the measured mean)")
-        u_ex[:, INPUT_BLOCKS["wind"].start] = np.interp(t, wind.t, wind.rotor_effective) - lc.wind_speed
-        u_ex[:, INPUT_BLOCKS["hub_wind"].start] = np.interp(t, wind.t, wind.hub)
+        tw = t - advection_delay(sim, wind)  # the wind the rotor meets now passed the measurement plane at tw
+        u_ex[:, INPUT_BLOCKS["wind"].start] = np.interp(tw, wind.t, wind.rotor_effective) - lc.wind_speed
+        u_ex[:, INPUT_BLOCKS["hub_wind"].start] = np.interp(tw, wind.t, wind.hub)
         i_sh = INPUT_BLOCKS["shear"].start
-        u_ex[:, i_sh] = np.interp(t, wind.t, wind.shear_y) if wind.shear_y is not None else sim.mean_shear[0]
-        u_ex[:, i_sh + 1] = np.interp(t, wind.t, wind.shear_z) if wind.shear_z is not None else sim.mean_shear[1]
+        u_ex[:, i_sh] = np.interp(tw, wind.t, wind.shear_y) if wind.shear_y is not None else sim.mean_shear[0]
+        u_ex[:, i_sh + 1] = np.interp(tw, wind.t, wind.shear_z) if wind.shear_z is not None else sim.mean_shear[1]
         if wind.blade is not None:
             b = wind.blade
             if b.shape[1] != N_BLADE_AZIMUTH:
@@ -623,14 +677,14 @@ def replay_forcing(sim: Simulator, n_steps: int, t_start: float, waves: Measured
                                          / b.shape[1], N_BLADE_AZIMUTH)
             blade = np.empty((n, N_BLADE_AZIMUTH), dtype=np.float32)
             for j in range(N_BLADE_AZIMUTH):
-                blade[:, j] = np.interp(t, wind.t, b[:, j])
+                blade[:, j] = np.interp(tw, wind.t, b[:, j])
         else:
             blade = np.zeros((0, N_BLADE_AZIMUTH), dtype=np.float32)
     return np.ascontiguousarray(u_ex), vel, psi0, np.ascontiguousarray(blade)
 
 
-def replay_meta(waves: MeasuredWaves | None, wind: MeasuredWind | None, t_start: float) -> dict[str, Mapping[str, Any]
-                                                                                               | float | None]:
+def replay_meta(waves: MeasuredWaves | None, wind: MeasuredWind | None, t_start: float,
+                wind_delay_s: float | None = None) -> dict[str, Mapping[str, Any] | float | None]:
     """JSON-able description of the replayed inputs for a record's ``meta``."""
     return {
         "t_start": float(t_start),
@@ -638,5 +692,6 @@ def replay_meta(waves: MeasuredWaves | None, wind: MeasuredWind | None, t_start:
                                              "f_max_hz": waves.f_max_hz, "taper_s": waves.taper_s,
                                              "direction_deg": waves.direction_deg},
         "wind": None if wind is None else {"source": wind.source, "level": wind.level,
-                                           "mean_hub_speed": wind.mean_speed()},
+                                           "mean_hub_speed": wind.mean_speed(), "x_ref": wind.x_ref,
+                                           "advection_delay_s": wind_delay_s},
     }

@@ -57,7 +57,14 @@ from scipy.fft import irfft, next_fast_len, rfft
 
 from .model import INPUT_BLOCKS
 from .oc3 import WATER_DEPTH
-from .replay import _PAD_SECONDS, DEFAULT_TAPER_S, MIN_RECORD_SECONDS, _profile_disc_mean, blade_effective_wind
+from .replay import (
+    _PAD_SECONDS,
+    DEFAULT_TAPER_S,
+    MIN_RECORD_SECONDS,
+    _profile_disc_mean,
+    advection_delay,
+    blade_effective_wind,
+)
 from .simulate import N_BLADE_AZIMUTH, N_EX, Simulator
 from .validation import check_number
 from .waves import SparGeometry, _loads_from_transfer_series, _wave_transfer_rows
@@ -187,6 +194,9 @@ class StreamedWind:
         Rotor radius and hub height (m).
     taper_s, margin_s, ends
         As :class:`StreamedWaves` (s; the hub column's ends).
+    x_ref : float or None
+        Plane where the wind was measured (m downwind; as :class:`surrogates.replay.MeasuredWind`): default 0, a
+        fixed point at the platform's undisplaced axis (OpenFAST's ``Wind1VelX``); None: at the rotor.
     """
 
     series: MeasuredSeries
@@ -204,6 +214,7 @@ class StreamedWind:
     taper_s: float = DEFAULT_TAPER_S
     margin_s: float = DEFAULT_WIND_MARGIN_S
     ends: tuple[np.ndarray, np.ndarray] | None = None
+    x_ref: float | None = 0.0
 
     def __post_init__(self) -> None:
         if self.level not in ("hub", "rotor_effective", "field", "given"):
@@ -353,6 +364,9 @@ class ReplayForcing:
             self.wind_mean, self.wind_dc = self._reference(v, wind.hub_column, wind.mean, wind.taper_s, wind.ends)
             if self.wind_mean <= 0:
                 raise ValueError(f"wind: the mean hub wind must be > 0 m/s, got {self.wind_mean:g}")
+        # Taylor advection from the wind's plane to the rotor (as surrogates.replay.replay_forcing)
+        self.wind_delay = advection_delay(sim, x_ref=wind.x_ref,
+                                          mean_speed=self.wind_mean if wind.level == "hub" else lc.wind_speed)
         geo = SparGeometry()
         z, _, _ = geo.strips(sim.strip_z.size)
         self._transfer_z = z
@@ -482,7 +496,8 @@ class ReplayForcing:
         wv, wd = self.waves, self.wind
         ra = self._rows(wv.series, float(t[0]), float(t[-1]), wv.margin_s)
         margin_wind = wd.margin_s if wd.level == "hub" else 0.0
-        rb = self._rows(wd.series, float(t[0]), float(t[-1]), margin_wind)
+        tw = t - self.wind_delay  # the wind the rotor meets now passed the measurement plane at tw
+        rb = self._rows(wd.series, float(tw[0]), float(tw[-1]), margin_wind)
         if wv.series is wd.series:
             lo, hi = min(ra[0], rb[0]), max(ra[1], rb[1])
             both = wv.series.read(lo, hi)
@@ -500,7 +515,7 @@ class ReplayForcing:
         u_ex[:n_in, INPUT_BLOCKS["wave"]] = excitation + sim.drag.excitation(vel[:n_in])
         u_ex[:n_in, INPUT_BLOCKS["elev"].start] = series[:, 0]
         hub, eff, shy, shz, blade_in = self._wind_series(
-            t, block_v, rb[0], self._window_rows(wd.series, n_steps, sim.dt_int, margin_wind))
+            tw, block_v, rb[0], self._window_rows(wd.series, n_steps, sim.dt_int, margin_wind))
         u_ex[:n_in, INPUT_BLOCKS["wind"].start] = eff - lc.wind_speed
         u_ex[:n_in, INPUT_BLOCKS["hub_wind"].start] = hub
         i_sh = INPUT_BLOCKS["shear"].start

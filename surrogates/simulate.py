@@ -70,7 +70,7 @@ N_EX = INPUT_BLOCKS["shear"].stop  # exogenous (precomputed) inputs: const, wave
 _PLATFORM_DOF = {"PtfmSurge": 0, "PtfmSway": 1, "PtfmHeave": 2, "PtfmRoll": 3, "PtfmPitch": 4, "PtfmYaw": 5}
 _PLATFORM_RATE = {"PtfmTVxi": 0, "PtfmTVyi": 1, "PtfmTVzi": 2, "PtfmRVxi": 3, "PtfmRVyi": 4, "PtfmRVzi": 5}
 """ElastoDyn's platform velocities (m/s, deg/s) as initial conditions of the platform DOFs' rates."""
-_INITIAL_CHANNELS = (*_PLATFORM_DOF, *_PLATFORM_RATE, "TTDspFA", "TTDspSS", "RotSpeed")
+_INITIAL_CHANNELS = (*_PLATFORM_DOF, *_PLATFORM_RATE, "TTDspFA", "TTDspSS", "RotSpeed", "BldPitch1", "GenTq")
 
 
 def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: int) -> None:
@@ -93,8 +93,12 @@ def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: i
 # ------------------------------------------------------------------------------------------------ kernel
 # scalar parameters of the kernel, packed in one float array ``par``
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
-    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_RQ, P_RS, P_RTY = range(22)
-N_PAR = 22
+    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_RQ, P_RS, P_RTY, P_SKIN, P_MZG = range(24)
+N_PAR = 24
+I_ACC = N_CONTROLLER_STATE
+"""Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
+accelerations of the previous internal step (m/s^2, rad/s^2), which the CM kinematics (``cm_kinematics``) read."""
+N_CARRIED = N_CONTROLLER_STATE + 3
 FIELD_DT = 0.05
 """Time step (s) of the synthesised turbulent field over the rotor disc."""
 N_BLADE_AZIMUTH = 24
@@ -171,6 +175,19 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
             for j in range(6):
                 acc += moor_jac[i, j] * x[j]
             u[nl0 + i] += s_moor * acc
+    # --- second-order kinematics of the platform's rotations (cm_kinematics): the structure's centre of mass sits
+    #     z_G below the reference point, at height z + z_G cos(theta) cos(phi), so the heave equation carries
+    #     M z_G (theta'^2 + theta theta'' + phi'^2 + phi phi'') and pitch and roll the reciprocal M z_G theta z''
+    #     (Lagrange's equations to second order; OpenFAST's ElastoDyn keeps them whole). The accelerations are the
+    #     previous step's (the coupling is weak: (M z_G theta)^2 / (M I) < 1 %)
+    s_kin = par[P_SKIN]
+    if s_kin > 0.0:
+        mzg = s_kin * par[P_MZG]
+        phi_r, theta = x[3], x[4]
+        u[nl0 + 2] += mzg * (x[nd + 4] * x[nd + 4] + theta * ctrl[I_ACC + 2]
+                             + x[nd + 3] * x[nd + 3] + phi_r * ctrl[I_ACC + 1])
+        u[nl0 + 3] += mzg * phi_r * ctrl[I_ACC]
+        u[nl0 + 4] += mzg * theta * ctrl[I_ACC]
     # --- nonlinear rotor: Ct/Cq surfaces at the wind relative to the moving hub, DISCON's torque and pitch
     domega = 0.0
     if par[P_ROTOR] > 0.0:
@@ -323,6 +340,8 @@ def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, v
                 acc += g_rest[r, i] * u[N_EX + i]
             xn[r] = acc
         psi += (harm[3] + x[20]) * dt
+        for i in range(3):  # heave, roll, pitch accelerations over the step, for the next step's CM kinematics
+            ctrl[I_ACC + i] = (xn[N_DOF + 2 + i] - x[N_DOF + 2 + i]) / dt
         for r in range(n_x):
             x[r] = xn[r]
         if rotor:
@@ -458,10 +477,11 @@ class Simulator:
             par[P_RS] = BLADE_SAMPLING_RADIUS * rt.radius
         self.par = par
         self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
+        par[P_SKIN] = float(eff["cm_kinematics"])
+        par[P_MZG] = float(st.mass[0, 4] - d.added_mass[0, 4])  # the structure's first mass moment M z_G (kg m)
+        self.ctrl0 = np.zeros(N_CARRIED)  # controller state, then the previous step's accelerations (I_ACC)
         if op is not None:
-            self.ctrl0 = initial_controller_state(d.gearbox_ratio * op.rotor_speed, op.pitch)
-        else:
-            self.ctrl0 = np.zeros(N_CONTROLLER_STATE)
+            self.ctrl0[:N_CONTROLLER_STATE] = initial_controller_state(d.gearbox_ratio * op.rotor_speed, op.pitch)
         self.mean_shear = np.zeros(2)
         if self.case is not None and self.case.wind_speed > 0:
             self.mean_shear[1] = mean_shear_z(self.case.wind_speed)
@@ -532,7 +552,10 @@ class Simulator:
     def initial_state(self, initial: Mapping[str, float] | None) -> tuple[np.ndarray, np.ndarray]:
         """State and controller state to start from: the equilibrium, with ``initial`` (OpenFAST channel name ->
         value in OpenFAST units) overriding platform DOFs and their rates (``PtfmTVxi`` ... ``PtfmRVzi``), tower-top
-        deflections and the rotor speed."""
+        deflections, the rotor speed, and the controller's pitch (``BldPitch1``, deg) and generator torque
+        (``GenTq``, kN·m): with these the controller starts where a record's was (its integrator consistent with
+        that pitch at that speed, :func:`surrogates.controller.initial_controller_state`), not from its steady
+        state -- a replay's rotor speed, and with it the azimuth, then follows the record's from the start."""
         x = self.x_eq.copy()
         ctrl = self.ctrl0.copy()
         if not initial:
@@ -556,8 +579,15 @@ class Simulator:
                     raise ValueError("initial: RotSpeed needs an operating load case (the rotor is parked)")
                 x[2 * N_DOF] = v * np.pi / 30.0 - self.system.rotor_speed
                 ctrl[0] = st.data.gearbox_ratio * v * np.pi / 30.0
+            elif name in ("BldPitch1", "GenTq"):
+                if not self.system.op:
+                    raise ValueError(f"initial: {name} needs an operating load case (the rotor is parked)")
             else:
                 raise ValueError(f"initial: unknown channel {name!r}; known: {sorted(_INITIAL_CHANNELS)}")
+        if self.system.op and ("BldPitch1" in initial or "GenTq" in initial):
+            pitch = np.deg2rad(float(initial["BldPitch1"])) if "BldPitch1" in initial else float(ctrl[2])
+            torque = 1e3 * float(initial["GenTq"]) if "GenTq" in initial else None
+            ctrl[:N_CONTROLLER_STATE] = initial_controller_state(float(ctrl[0]), pitch, torque)
         return x, ctrl
 
     def advance(self, x: np.ndarray, ctrl: np.ndarray, psi: float, k0: int, n_steps: int, every: int,
@@ -712,7 +742,14 @@ def simulate(
         raise ValueError(f"transient must be finite and >= 0 (s), got {transient!r}")
     replay = waves is not None or wind is not None
     if replay:
-        from .replay import as_measured_waves, as_measured_wind, replay_forcing, replay_meta, replay_window
+        from .replay import (
+            advection_delay,
+            as_measured_waves,
+            as_measured_wind,
+            replay_forcing,
+            replay_meta,
+            replay_window,
+        )
 
         waves = None if waves is None else as_measured_waves(waves)
         wind = None if wind is None else as_measured_wind(wind)
@@ -787,7 +824,8 @@ def simulate(
             "initial": dict(initial) if initial else None,
         }
         if replay:
-            meta["replay"] = replay_meta(waves, wind, t_start)
+            meta["replay"] = replay_meta(waves, wind, t_start,
+                                         None if wind is None else advection_delay(sim, wind))
         noisy = sim.add_noise(truth, ch[1]) if noise else truth
         rec = Record(t, noisy, list(ALL_CHANNELS), [UNITS[c] for c in ALL_CHANNELS], meta)
         if return_truth:

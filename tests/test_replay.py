@@ -79,7 +79,7 @@ def test_replayed_forcing_equals_the_synthesised_forcing():
     hub = u_ex[:, INPUT_BLOCKS["hub_wind"].start]
     eff = u_ex[:, INPUT_BLOCKS["wind"].start] + lc.wind_speed
     shear = u_ex[:, INPUT_BLOCKS["shear"]]
-    wind = MeasuredWind(t, hub, eff, shear[:, 0], shear[:, 1], blade, level="field")
+    wind = MeasuredWind(t, hub, eff, shear[:, 0], shear[:, 1], blade, level="field", x_ref=None)  # drawn at the rotor
     u2, v2, p2, b2 = replay_forcing(sim, n_steps, 0.0, MeasuredWaves(t, elev), wind,
                                     np.random.SeedSequence(3).spawn(2)[0])
     assert p2 == psi0
