@@ -2,7 +2,7 @@
 
 The 'measurement' is the full surrogate on OLC 7 with the tower's fore-aft bending stiffness at 0.9 (a hidden
 parametric truth); the candidate model is the nominal one; the candidates are all of
-``fowt_env.discrepancy.CANDIDATES``: the ten effects of ``surrogates.EFFECTS`` and the ten parameter multipliers
+``fowt_env.discrepancy.CANDIDATES``: the eleven effects of ``surrogates.EFFECTS`` and the ten parameter multipliers
 of ``surrogates.parameters.PARAMETERS``. Prints the wall time, the number of model simulations, the machine's load
 (other jobs on the same cores slow every simulation), the process's CPU time (what the run costs when it has
 the cores to itself) and the report.

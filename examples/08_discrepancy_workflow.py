@@ -43,7 +43,7 @@ What to look for.
   discrepancy" is the honest answer -- a limit of the data, not of the method.
 
 The measured record is ten minutes long. ``--quick`` tests three candidate effects on a coarser strength grid
-instead of all twenty candidates (``discrepancy.CANDIDATES``: ten effects, ten parameters) on the default grid.
+instead of all 21 candidates (``discrepancy.CANDIDATES``: eleven effects, ten parameters) on the default grid.
 Writes ``08_discrepancy.png`` (gaps, features, candidates) and ``08_discrepancy_report.png`` (``report.plot``:
 spectra of measurement, candidate and updated model). This is the last lesson; ``fowt-env discrepancy FILE --case
 N`` runs the same workflow on a record of your own.

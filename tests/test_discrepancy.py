@@ -130,7 +130,7 @@ SWELL_PARKED = surrogates.load_case(12).replace(tp=16.0, wave_dir_deg=0.0, wind_
                                                 turbulence_intensity=0.0, name="parked, 16 s swell from ahead")
 
 # Every parameter of surrogates.parameters but the drag coefficient hidden at two strengths, on either side of
-# nominal where the physics allows, under two load cases; the workflow searches all 20 candidates (10 effects + 10
+# nominal where the physics allows, under two load cases; the workflow searches all 21 candidates (11 effects + 10
 # parameters). The values are where 20 minutes of the channels show the change; smaller ones are not seen (README,
 # "Detection limits": e.g. structural damping x0.5, added mass x1.1, drag Cd x0.4-2.5, platform inertia at 12 m/s).
 PARAMETER_TRUTHS = [
@@ -252,7 +252,7 @@ NULL_RECORDS = [(7, 71), (4, 72), (10, 73), (3, 74), (7, 75)] + [(1 + i % 12, 20
 
 @pytest.mark.slow
 def test_with_nothing_hidden_nothing_is_named_in_19_of_20_records():
-    """The null case with every candidate (20): the same physics as the model, twenty other seeds. The workflow's
+    """The null case with every candidate (21): the same physics as the model, twenty other seeds. The workflow's
     level is the 99th percentile of its null gap, so about one record in a hundred may be called significant; a
     named effect in more than one of twenty would be a false discovery rate the level does not promise."""
     answers = []

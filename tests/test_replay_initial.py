@@ -39,3 +39,58 @@ def test_simulation_starts_with_the_given_platform_velocity():
     assert slope == pytest.approx(v0, rel=0.02)
     with pytest.raises(ValueError, match="unknown channel"):
         surrogates.simulate(model, None, duration=1.0, initial={"PtfmTVxx": 1.0})
+
+
+def test_controller_starts_from_a_measured_pitch_and_torque():
+    """initial_controller_state: the PI integrator is set so that the DLL's next command equals the given pitch at
+    the given speed error (continuity, closed form of the PI law); at the minimum pitch it rests on its lower
+    limit (below rated); the torque is taken as given."""
+    from surrogates.controller import DISCON, PARAMS, discon_step, initial_controller_state
+
+    ref = DISCON["PC_RefSpd"]
+    for speed, pitch in ((ref + 3.0, np.deg2rad(8.0)), (ref - 2.0, np.deg2rad(2.0)), (ref, np.deg2rad(14.0))):
+        state = initial_controller_state(speed, pitch, torque=40e3)
+        assert state[3] == 40e3
+        s = state.copy()
+        discon_step(PARAMS, s, speed, 1e-4)  # 0.1 ms later, the same speed: the command has not moved
+        assert s[2] == pytest.approx(pitch, abs=1e-5)
+    below = initial_controller_state(ref - 20.0, 0.0)
+    assert below[1] == 0.0 and below[2] == 0.0
+
+
+def test_replay_initial_pitch_and_torque_reach_the_controller():
+    lc = surrogates.operating_case(18.0, 0.0, 10.0, turbulence_intensity=0.0)
+    sim = surrogates.Simulator(surrogates.FOWTModel(), lc)
+    x, ctrl = sim.initial_state({"RotSpeed": 11.0, "BldPitch1": 10.0, "GenTq": 43.0})
+    assert ctrl[2] == pytest.approx(np.deg2rad(10.0)) and ctrl[3] == pytest.approx(43e3)
+    assert ctrl[0] == pytest.approx(sim.system.structure.data.gearbox_ratio * 11.0 * np.pi / 30.0)
+    with pytest.raises(ValueError, match="parked"):
+        surrogates.Simulator(surrogates.FOWTModel(), None).initial_state({"BldPitch1": 3.0})
+
+
+def test_measured_wind_is_advected_from_its_plane_to_the_rotor():
+    """Taylor's frozen turbulence: a wind measured x_ref metres downwind of the platform axis reaches the rotor
+    (x_rotor - x_ref) / U later; moving the plane 2 U metres upwind delays it by 2 s more; a wind measured at the
+    rotor (x_ref None) is not delayed. The replayed rotor-level input is the measured series shifted by it."""
+    from surrogates.model import INPUT_BLOCKS
+    from surrogates.replay import MeasuredWind, advection_delay, replay_forcing
+
+    lc = surrogates.operating_case(12.0, 0.0, 10.0, turbulence_intensity=0.0)
+    sim = surrogates.Simulator(surrogates.FOWTModel(), lc)
+    t = np.arange(0.0, 400.0, 0.05)
+    u = 12.0 + np.sin(2 * np.pi * 0.05 * t)
+    at_rotor = MeasuredWind.from_rotor_effective(t, u)
+    fixed = MeasuredWind.from_rotor_effective(t, u, x_ref=0.0)
+    upwind = MeasuredWind.from_rotor_effective(t, u, x_ref=-2.0 * at_rotor.mean_speed())
+    d0 = advection_delay(sim, fixed)
+    assert advection_delay(sim, at_rotor) == 0.0
+    st = sim.system.structure
+    surge, pitch = sim.x_eq[0], sim.x_eq[4]
+    assert d0 == pytest.approx((surge + st.hub_position[2] * pitch + st.hub_position[0]) / 12.0, abs=0.15)
+    assert 1.0 < d0 < 3.0  # ~21 m downwind at 12 m/s: mean surge ~20 m, pitch ~4 deg, overhang 5 m upwind
+    assert advection_delay(sim, upwind) == pytest.approx(d0 + 2.0, rel=1e-9)
+    n = int(300.0 / sim.dt_int)
+    u_ex, _, _, _ = replay_forcing(sim, n, 50.0, None, fixed, np.random.SeedSequence(0))
+    tt = 50.0 + np.arange(n + 1) * sim.dt_int
+    got = u_ex[:, INPUT_BLOCKS["wind"].start] + lc.wind_speed
+    assert np.max(np.abs(got - (12.0 + np.sin(2 * np.pi * 0.05 * (tt - d0))))) < 1e-3
