@@ -239,27 +239,41 @@ def test_bts_reader_and_field_reduction(tmp_path):
         read_bts(p)
 
 
+# issue 16's target on the shared turbulent runs: R^2 >= 0.85 x the multiple-coherence bound for these channels in
+# the wave band and over 0-1 Hz, and >= 0.9 in the wave band for the fore-aft tower. The three misses measured on
+# this physics (README, "Replay measured conditions": the 1st tower mode band's rotationally sampled turbulence is
+# azimuth-phase sensitive) are held to floors instead, so that they cannot get worse unseen.
+REPLAY_TARGET_CHANNELS = ("PtfmSurge", "PtfmHeave", "PtfmPitch", "TwrBsMyt", "TwHt9ALxt", "RotSpeed", "BldPitch1")
+REPLAY_KNOWN_MISSES = {("c_op08_Hs2p0_Tp9", "TwrBsMyt", "0-1 Hz"): 0.6, ("c_op08_Hs2p0_Tp9", "TwHt9ALxt", "0-1 Hz"): 0.35,
+                       ("c_op12_Hs2p5_Tp10", "TwHt9ALxt", "0-1 Hz"): 0.4}
+
+
 @pytest.mark.slow
-@pytest.mark.skipif(not (RUNS / "c_op12_Hs2p5_Tp10").is_dir(), reason="shared OpenFAST runs not available")
-def test_openfast_12mps_replay_matches_in_the_wave_band():
-    """Issue 16 on the shared 12 m/s run (polar rotor field of its inflow file): in the wave band R^2 >= 0.9 for
-    TwrBsMyt and TwHt9ALxt and >= 0.85 x the multiple-coherence bound for surge, heave and pitch."""
+@pytest.mark.parametrize("run", ["c_op08_Hs2p0_Tp9", "c_op12_Hs2p5_Tp10", "c_op18_Hs4p0_Tp11"])
+def test_openfast_replay_meets_the_coherence_targets(run):
+    """Issue 16 on each shared turbulent run (polar rotor field of its inflow file, the record's initial state)."""
     from fowt_env.io import load_record
     from fowt_env.replay import replay_record
 
-    folder = RUNS / "c_op12_Hs2p5_Tp10"
-    rec = load_record(folder / "c_op12_Hs2p5_Tp10.outb", unknown_channels="keep")
-    rp = replay_record(folder / "c_op12_Hs2p5_Tp10.outb", transient=100.0)
-    with np.load(folder / "c_op12_Hs2p5_Tp10.inflow.npz", allow_pickle=False) as z:
+    folder = RUNS / run
+    if not folder.is_dir():
+        pytest.skip("shared OpenFAST runs not available")
+    rec = load_record(folder / f"{run}.outb", unknown_channels="keep")
+    rp = replay_record(folder / f"{run}.outb", transient=100.0)
+    assert rp.meta["replay"]["wind"]["advection_delay_s"] > 0.3  # the rotor sits downwind of OpenFAST's x = 0
+    with np.load(folder / f"{run}.inflow.npz", allow_pickle=False) as z:
         rotor_wind = (np.asarray(z["t"]), np.asarray(z["disc_mean_u"], float))
-    scores = {(s.channel, s.band): s for s in replay_scores(rec, rp, rotor_wind)}
-    assert scores["TwrBsMyt", "wave"].r2 >= 0.9
-    assert scores["TwHt9ALxt", "wave"].r2 >= 0.9
-    # Heave misses the issue's 0.85 x bound since the thrust follows the rotor axis (bc7480e): the follower
-    # thrust's -T theta gave heave OpenFAST's mean set-down and std (validate) but in replay the surrogate's heave
-    # follows its platform pitch more than OpenFAST's does; wave band 0.71 -> 0.55 (bound 0.76, i.e. 0.72 x).
-    # Kept as a regression floor; the target stays open in issue 16.
-    factor = {"PtfmSurge": 0.85, "PtfmHeave": 0.65, "PtfmPitch": 0.85}
-    for ch in ("PtfmSurge", "PtfmHeave", "PtfmPitch"):
-        s = scores[ch, "wave"]
-        assert s.r2 >= factor[ch] * s.bound, (ch, s.r2, s.bound)
+    scores = replay_scores(rec, rp, rotor_wind, channels=REPLAY_TARGET_CHANNELS)
+    checked = 0
+    for s in scores:
+        if not np.isfinite(s.bound):  # BldPitch1 at 8 m/s: constant 0 in both
+            continue
+        checked += 1
+        floor = REPLAY_KNOWN_MISSES.get((run, s.channel, s.band))
+        if floor is not None:
+            assert s.r2 >= floor, (s.channel, s.band, s.r2)
+            continue
+        assert s.r2 >= 0.85 * s.bound, (s.channel, s.band, s.r2, s.bound)
+        if s.band == "wave" and s.channel in ("TwrBsMyt", "TwHt9ALxt"):
+            assert s.r2 >= 0.9, (s.channel, s.r2)
+    assert checked >= 12
