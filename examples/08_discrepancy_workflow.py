@@ -85,7 +85,7 @@ def main(quick: bool = False, out: str = ".", hide: str = "mooring_nonlinear") -
     print(report.summary())
 
     # the gap each candidate effect reaches at its best strength, in the first round of the search
-    first_round = [c for c in report.candidates if c["round"] == 1]
+    first_round = [c for c in report.candidates if c["round"] == 1 and c["gap"] is not None]  # not the diverged
     threshold = report.detect_gap  # the significance level: 99th percentile of the model's null gaps
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 5.5), gridspec_kw={"width_ratios": [0.8, 1.6, 1.2]})

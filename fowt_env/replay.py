@@ -65,6 +65,9 @@ REPLAY_CHANNELS: tuple[str, ...] = ("PtfmSurge", "PtfmHeave", "PtfmPitch", "TwrB
 SEGMENT_S = 100.0
 """Welch segment length (s) of the coherence bound: 0.01 Hz resolution, ~10 averages over a 600 s record."""
 
+ROTOR_INITIAL_CHANNELS: tuple[str, ...] = ("RotSpeed", "Azimuth", "BldPitch1", "GenTq")
+"""Initial conditions of the rotor and its controller: dropped when the load case is parked."""
+
 _INITIAL_CHANNELS = ("PtfmSurge", "PtfmSway", "PtfmHeave", "PtfmRoll", "PtfmPitch", "PtfmYaw", "TTDspFA", "TTDspSS",
                      "RotSpeed", "Azimuth", "BldPitch1", "GenTq")
 
@@ -280,7 +283,7 @@ def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: A
         raise ValueError("the record has neither a wave elevation (Wave1Elev) nor a wind (Wind1VelX) to replay")
     init = record_initial(record) if initial else None
     if init and lc.wind_speed <= 0:
-        for name in ("RotSpeed", "Azimuth", "BldPitch1", "GenTq"):
+        for name in ROTOR_INITIAL_CHANNELS:
             init.pop(name, None)
     return surrogates.simulate(model, lc, dt=dt, seed=seed, transient=transient, noise=False, initial=init,
                                waves=waves_in, wind=wind_in, on_progress=on_progress)

@@ -62,8 +62,8 @@ EFFECTS: dict[str, Effect] = {
                "quadratic in the hub-height wind.", linear=False),
         Effect("cm_kinematics", "Second-order kinematics of the platform's rotations: the centre of mass, ~78 m "
                "below the SWL, rises as the spar tilts, so pitch and roll rates and accelerations force heave "
-               "(M z_G (theta'^2 + theta theta'')) and heave accelerations load pitch and roll; at a mean tilt, the "
-               "heave-pitch inertial coupling.", linear=False),
+               "(M z_G (cos(theta) theta'^2 + sin(theta) theta'')) and heave accelerations load pitch and roll; "
+               "at a mean tilt, the heave-pitch inertial coupling.", linear=False),
         Effect("p_delta", "Gravity geometric softening: the weight of tower and RNA acting through the lateral "
                "displacements of tilt and bending (P-delta).", linear=True),
     )

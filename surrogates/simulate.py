@@ -176,18 +176,20 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 acc += moor_jac[i, j] * x[j]
             u[nl0 + i] += s_moor * acc
     # --- second-order kinematics of the platform's rotations (cm_kinematics): the structure's centre of mass sits
-    #     z_G below the reference point, at height z + z_G cos(theta) cos(phi), so the heave equation carries
-    #     M z_G (theta'^2 + theta theta'' + phi'^2 + phi phi'') and pitch and roll the reciprocal M z_G theta z''
-    #     (Lagrange's equations to second order; OpenFAST's ElastoDyn keeps them whole). The accelerations are the
+    #     z_G below the reference point, at height z + z_G cos(theta) (and the same in roll), so the heave
+    #     equation carries M z_G (cos(theta) theta'^2 + sin(theta) theta'') and pitch the reciprocal
+    #     M z_G sin(theta) z'' (Lagrange's equations for a rotation about one axis, each axis on its own: what the
+    #     linear model lacks; OpenFAST's ElastoDyn keeps the whole rigid-body kinematics). The accelerations are the
     #     previous step's (the coupling is weak: (M z_G theta)^2 / (M I) < 1 %)
     s_kin = par[P_SKIN]
     if s_kin > 0.0:
         mzg = s_kin * par[P_MZG]
-        phi_r, theta = x[3], x[4]
-        u[nl0 + 2] += mzg * (x[nd + 4] * x[nd + 4] + theta * ctrl[I_ACC + 2]
-                             + x[nd + 3] * x[nd + 3] + phi_r * ctrl[I_ACC + 1])
-        u[nl0 + 3] += mzg * phi_r * ctrl[I_ACC]
-        u[nl0 + 4] += mzg * theta * ctrl[I_ACC]
+        s_phi, c_phi = math.sin(x[3]), math.cos(x[3])
+        s_th, c_th = math.sin(x[4]), math.cos(x[4])
+        u[nl0 + 2] += mzg * (c_th * x[nd + 4] * x[nd + 4] + s_th * ctrl[I_ACC + 2]
+                             + c_phi * x[nd + 3] * x[nd + 3] + s_phi * ctrl[I_ACC + 1])
+        u[nl0 + 3] += mzg * s_phi * ctrl[I_ACC]
+        u[nl0 + 4] += mzg * s_th * ctrl[I_ACC]
     # --- nonlinear rotor: Ct/Cq surfaces at the wind relative to the moving hub, DISCON's torque and pitch
     domega = 0.0
     if par[P_ROTOR] > 0.0:
