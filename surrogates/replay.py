@@ -552,8 +552,9 @@ def advection_delay(sim: Simulator, wind: MeasuredWind | None = None, *, x_ref: 
     """Time (s) the measured wind takes from its plane ``x_ref`` to the rotor (Taylor's frozen turbulence).
 
     The rotor apex's mean downwind position is taken at the simulator's static equilibrium (mean surge, mean
-    pitch, the tower's mean bending, the overhang); the wind is advected at its mean hub-height speed. The
-    rotor's motion about that mean is left to the hub-relative wind the aerodynamics already use.
+    pitch, the tower's mean bending, the overhang); the wind is advected at the load case's wind speed (a
+    replay's linearisation point: the measured mean), so that every replay path of one simulator delays alike.
+    The rotor's motion about that mean is left to the hub-relative wind the aerodynamics already use.
 
     Parameters
     ----------
@@ -563,16 +564,17 @@ def advection_delay(sim: Simulator, wind: MeasuredWind | None = None, *, x_ref: 
     x_ref : float or None
         Plane of the measurement (m downwind); None: at the rotor (delay 0).
     mean_speed : float, optional
-        Mean hub-height wind (m/s); default ``wind``'s, else the simulator's load case's.
+        Advection speed (m/s); default the simulator's load case's wind speed, else ``wind``'s mean hub speed.
     """
     from .structure import N_DOF
 
     if wind is not None:
-        x_ref, mean_speed = wind.x_ref, wind.mean_speed()
+        x_ref = wind.x_ref
     if x_ref is None:
         return 0.0
     if mean_speed is None:
-        mean_speed = sim.case.wind_speed if sim.case is not None else 0.0
+        mean_speed = sim.case.wind_speed if sim.case is not None and sim.case.wind_speed > 0 else (
+            wind.mean_speed() if wind is not None else 0.0)
     st = sim.system.structure
     x_rotor = float(st.hub_position[0] + st.hub_translation[0] @ sim.x_eq[:N_DOF])
     return (x_rotor - float(x_ref)) / max(float(mean_speed), 0.1)

@@ -365,8 +365,7 @@ class ReplayForcing:
             if self.wind_mean <= 0:
                 raise ValueError(f"wind: the mean hub wind must be > 0 m/s, got {self.wind_mean:g}")
         # Taylor advection from the wind's plane to the rotor (as surrogates.replay.replay_forcing)
-        self.wind_delay = advection_delay(sim, x_ref=wind.x_ref,
-                                          mean_speed=self.wind_mean if wind.level == "hub" else lc.wind_speed)
+        self.wind_delay = advection_delay(sim, x_ref=wind.x_ref)
         geo = SparGeometry()
         z, _, _ = geo.strips(sim.strip_z.size)
         self._transfer_z = z

@@ -81,7 +81,7 @@ def test_measured_wind_is_advected_from_its_plane_to_the_rotor():
     u = 12.0 + np.sin(2 * np.pi * 0.05 * t)
     at_rotor = MeasuredWind.from_rotor_effective(t, u)
     fixed = MeasuredWind.from_rotor_effective(t, u, x_ref=0.0)
-    upwind = MeasuredWind.from_rotor_effective(t, u, x_ref=-2.0 * at_rotor.mean_speed())
+    upwind = MeasuredWind.from_rotor_effective(t, u, x_ref=-2.0 * lc.wind_speed)  # advected at the case speed
     d0 = advection_delay(sim, fixed)
     assert advection_delay(sim, at_rotor) == 0.0
     st = sim.system.structure
