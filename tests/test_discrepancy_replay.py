@@ -146,6 +146,7 @@ def _names_the_truth_or_nothing(rep, name, truth, candidate):
 
 
 @pytest.mark.slow
+@pytest.mark.matrix  # ~110 s; .ci/run keeps replay mode's parked drag-coefficient test
 def test_replay_names_a_missing_quadratic_drag_at_rated_wind():
     """Truth: the full model; the candidate lacks ``quadratic_drag`` (OLC 7, 12 m/s, Hs 3 m). The statistical
     mode sees nothing (gap 1.31 against its level 2.73), nor does a replay from the hub wind alone: the
@@ -209,6 +210,7 @@ def test_replay_recovers_a_hidden_drag_coefficient_in_parked_seas(truth, hs, tp,
 
 
 @pytest.mark.slow
+@pytest.mark.matrix  # ~120 s
 def test_replay_names_an_added_mass_ten_percent_high_that_the_statistics_miss():
     """Truth: added mass x1.1 (OLC 7, seed 105). The statistical mode finds no significant discrepancy in this
     record (gap 1.51 against its level 2.55); under the record's own waves the wave-band response of every channel

@@ -96,6 +96,7 @@ def test_a_wrong_tower_stiffness_costs_the_nominal_kalman_filter_on_every_seed()
 
 
 @pytest.mark.slow
+@pytest.mark.matrix  # ~2 min of CPU for the four; .ci/run keeps the tower-stiffness direction test
 @pytest.mark.parametrize("label", [k for k in STANDARD_PERTURBATIONS if "tower" not in k])
 def test_platform_drag_mooring_and_imbalance_errors_are_below_the_seed_scatter(label):
     """Measured (README, model-error table): with 14 of 18 gauges live every sample, the platform-level errors
