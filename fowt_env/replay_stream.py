@@ -44,7 +44,7 @@ from typing import IO, Any
 import numpy as np
 from scipy.signal import get_window
 
-from surrogates.replay import MIN_RECORD_SECONDS, MeasuredWind
+from surrogates.replay import MIN_RECORD_SECONDS, MeasuredWind, record_wind_plane
 from surrogates.replay_stream import ArraySeries, ReplayForcing, StreamedWaves, StreamedWind
 
 __all__ = ["NpzSeries", "ReplaySource"]
@@ -329,7 +329,7 @@ class ReplaySource:
         elev_mean, wind_mean = (float(v) for v in scan.sums / scan.n)
         self.waves = StreamedWaves(series, column=0, mean=elev_mean, ends=(scan.heads[0], scan.tails[0]))
         # the record's Wind1VelX: at a fixed point at x = 0 (OpenFAST), or at the rotor (a surrogate's own record)
-        x_ref = None if self._source == "surrogates.simulate" else 0.0
+        x_ref = record_wind_plane(self._meta)
         self.wind = StreamedWind(series, "hub", hub_column=1, mean=wind_mean, ends=(scan.heads[1], scan.tails[1]),
                                  x_ref=x_ref)
         if wind is None and self.path is not None:
@@ -363,7 +363,7 @@ class ReplaySource:
         with zipfile.ZipFile(path) as z, z.open("header.npy") as fh:
             header = json.loads(str(np.lib.format.read_array(fh, allow_pickle=False)[()]))
         channels = list(header.get("channels", []))
-        self._source = (header.get("meta") or {}).get("source")
+        self._meta = header.get("meta")
         missing = [c for c in ("Wave1Elev", "Wind1VelX") if c not in channels]
         if missing:
             raise ValueError(f"replay: {path} has no {' and no '.join(missing)} channel (a replay needs the measured "
@@ -390,7 +390,7 @@ class ReplaySource:
         return series, scan
 
     def _scan_memory(self, rec: Any) -> tuple[ArraySeries, _Scan]:
-        self._source = (getattr(rec, "meta", None) or {}).get("source")
+        self._meta = getattr(rec, "meta", None)
         missing = [c for c in ("Wave1Elev", "Wind1VelX") if c not in rec.channels]
         if missing:
             raise ValueError(f"replay: the record has no {' and no '.join(missing)} channel (a replay needs the "

@@ -79,6 +79,7 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = [
     "MIN_RECORD_SECONDS",
     "advection_delay",
+    "record_wind_plane",
     "MeasuredWaves",
     "MeasuredWind",
     "as_measured_waves",
@@ -422,7 +423,7 @@ class MeasuredWind:
         Downwind position (m, inertial frame, from the platform's undisplaced axis) of the plane where the wind
         was measured; default 0: OpenFAST's convention (``Wind1VelX`` at (0, 0, hub height), the TurbSim field
         passing x = 0 at its own time). The replay carries it to the rotor's mean position by Taylor's frozen
-        turbulence: it reaches the rotor ``(x_rotor - x_ref) / U`` later (:func:`advection_delay`; ~1.9 s at
+        turbulence: it reaches the rotor ``(x_rotor - x_ref) / U`` later (:func:`advection_delay`; 2.1 s at
         12 m/s, where the rotor sits ~21 m downwind of x = 0). None: measured at the moving rotor (a rotor
         wind estimate, a spinner anemometer or a lidar referenced to the rotor): no delay.
     """
@@ -513,9 +514,8 @@ class MeasuredWind:
         """
         if channel not in getattr(record, "channels", ()):
             raise ValueError(f"wind: the record has no {channel!r} channel (hub-height wind, m/s)")
-        meta = getattr(record, "meta", None) or {}
-        if "x_ref" not in kwargs and meta.get("source") == "surrogates.simulate":
-            kwargs["x_ref"] = None
+        if "x_ref" not in kwargs:
+            kwargs["x_ref"] = record_wind_plane(getattr(record, "meta", None))
         return cls.from_hub(np.asarray(record.t), np.asarray(record[channel]),
                             source=f"record channel {channel}", **kwargs)
 
@@ -547,6 +547,13 @@ class MeasuredWind:
         return float(np.mean(self.hub))
 
 
+def record_wind_plane(meta: Mapping[str, Any] | None) -> float | None:
+    """Where a record's ``Wind1VelX`` was measured (:attr:`MeasuredWind.x_ref`), from the record's ``meta``: None
+    (at the rotor) for a record of :func:`surrogates.simulate`, whose wind is synthesised there; else 0, OpenFAST's
+    fixed point at the platform's undisplaced axis."""
+    return None if (meta or {}).get("source") == "surrogates.simulate" else 0.0
+
+
 def advection_delay(sim: Simulator, wind: MeasuredWind | None = None, *, x_ref: float | None = 0.0,
                     mean_speed: float | None = None) -> float:
     """Time (s) the measured wind takes from its plane ``x_ref`` to the rotor (Taylor's frozen turbulence).
@@ -560,7 +567,7 @@ def advection_delay(sim: Simulator, wind: MeasuredWind | None = None, *, x_ref: 
     ----------
     sim : Simulator
     wind : MeasuredWind, optional
-        Gives ``x_ref`` and the mean speed; otherwise pass them.
+        Gives ``x_ref`` (and the speed when the load case has none); otherwise pass ``x_ref``.
     x_ref : float or None
         Plane of the measurement (m downwind); None: at the rotor (delay 0).
     mean_speed : float, optional
