@@ -65,6 +65,8 @@ BELOW_RATED_WIND = 8.0  # m/s, region 2 of the controller (rated wind 11.4 m/s)
 OC3_REFERENCE_HZ = {
     "surge": 0.0080, "sway": 0.0080, "heave": 0.0324, "roll": 0.0342, "pitch": 0.0343, "yaw": 0.1210,
     "tower_fa_1": 0.483, "tower_ss_1": 0.492, "tower_fa_2": 2.554, "tower_ss_2": 2.053,
+    # 1st collective blade flap, parked (FAST; Jonkman et al. 2009, NREL/TP-500-38060, Table 9-1)
+    "blade_flap": 0.6993,
 }
 FA_MODES = ("surge", "pitch", "tower_fa_1", "tower_fa_2")  # displacements along x (downwind)
 SS_MODES = ("sway", "roll", "tower_ss_1", "tower_ss_2")  # displacements along y (to port)

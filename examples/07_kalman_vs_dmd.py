@@ -1,7 +1,7 @@
 """Lesson 7 -- Kalman vs DMD: a physics-based and a data-driven virtual sensor on the same failure.
 
 The physics. Lesson 6's Hankel-DMD sensor learned the tower's dynamics from data. The classical alternative
-starts from physics: the linearised model of lesson 2 (``FOWTModel().linearize(case, plane="FA")``, 22 states)
+starts from physics: the linearised model of lesson 2 (``FOWTModel().linearize(case, plane="FA")``, 24 states)
 in an *augmented Kalman filter* (``estimators.KalmanSensor``). The unknown loads -- wave forces, wind -- become
 extra states driven by noise; at every sample the filter predicts with the model and corrects with whichever
 channels are alive, weighting model and measurement by their uncertainties. Being probabilistic it also reports

@@ -44,6 +44,7 @@ __all__ = [
     "ROTOR_ORDERS",
     "IdentificationResult",
     "LinearReference",
+    "OVERDAMPED_LINE",
     "identify",
     "label_against_model",
     "linear_reference",
@@ -52,6 +53,9 @@ __all__ = [
 ]
 
 _TOWER_PREFIX = "TwHt"
+OVERDAMPED_LINE = 0.45
+"""Damping ratio (-) above which a model mode has no resonance peak to show as a spectral line (peak gain
+``1 / (2 zeta sqrt(1 - zeta^2))`` below 1.25): such a mode is not offered as the meaning of a data line."""
 
 
 @dataclass(frozen=True)
@@ -149,14 +153,18 @@ def model_reference(model: Any, case: Any = None, plane: str | None = None) -> L
     LinearReference
         Tower modes labelled as :meth:`FOWTModel.modal_analysis` names them (the platform modes lie below the
         identification band); :attr:`~LinearReference.model_modes` lists every mode of the modal analysis at
-        ``case`` (platform and both tower planes).
+        ``case`` (platform, both tower planes, the blades' flap) that can show as a spectral line (damping ratio
+        below :data:`OVERDAMPED_LINE`).
     """
     modes = model.modal_analysis(case)
     wanted = {lab: f for lab, f in zip(modes.labels, modes.frequencies_hz, strict=True) if lab.startswith("tower_")}
     ref = linear_reference(model.linearize(case, plane=plane), labels=wanted, f_min=0.5 * min(wanted.values()))
     keep = [k for k, lab in enumerate(ref.labels) if lab in wanted
             and (plane is None or lab.startswith(f"tower_{plane.lower()}_"))]
-    every = tuple((str(lab), float(f)) for lab, f in zip(modes.labels, modes.frequencies_hz, strict=True))
+    # a mode damped beyond OVERDAMPED_LINE (the operating rotor's blade flap, ~54 %) has no resonance peak (gain
+    # at most 1 / (2 zeta sqrt(1 - zeta^2)) < 1.25): no spectral line of the data can be it
+    every = tuple((str(lab), float(f)) for lab, f, z in zip(modes.labels, modes.frequencies_hz,
+                                                           modes.damping_ratios, strict=True) if z < OVERDAMPED_LINE)
     return LinearReference(ref.frequencies_hz[keep], ref.damping_ratios[keep], ref.shapes[:, keep],
                            [ref.labels[k] for k in keep], ref.channels, model_modes=every)
 

@@ -1,6 +1,6 @@
 """``FOWTModel``: the OC3 Hywind surrogate as a state-space system with switchable physical effects.
 
-State ``x`` (22): generalised displacements ``q`` (10, see :data:`surrogates.structure.DOF_LABELS`), their
+State ``x`` (24): generalised displacements ``q`` (11, see :data:`surrogates.structure.DOF_LABELS`), their
 rates, the rotor-speed deviation ``dOmega`` (rad/s) and the integral of it ``xi`` (rad, the pitch controller's
 integrator). Inputs ``u`` (28), in blocks:
 
@@ -16,7 +16,7 @@ shear      2      linear gradients of the streamwise wind over the rotor disc, `
                   the rotor's yaw and tilt moments and side force (the ``rotor_asymmetry`` effect)
 action     2      collective blade-pitch offset (rad), generator-torque offset (N·m, low-speed shaft)
 hub        6      rotor harmonic loads at the hub, global axes (N, N·m): the 1P/3P/6P effects
-nonlinear  10     generalised forces of the nonlinear effects (drag, catenary mooring)
+nonlinear  11     generalised forces of the nonlinear effects (drag, catenary mooring)
 rotor      5      quantities evaluated per step: blade pitch (rad), generator torque (N·m, HSS), electrical
                   power (W), aerodynamic thrust (N) of the nonlinear rotor (``rotor_nonlinear``; they reach the
                   outputs only, their loads enter through ``hub``), and ``V|V|`` of the hub-height wind
@@ -46,7 +46,7 @@ from .effects import resolve_effects
 from .load_cases import LoadCase, load_case
 from .oc3 import GRAVITY
 from .radiation import modal_radiation_damping
-from .structure import DOF_LABELS, N_DOF, Structure, build_structure
+from .structure import _FLAP, DOF_LABELS, N_DOF, Structure, build_structure
 
 __all__ = ["FOWTModel", "ModalResult", "LinearSystem", "RotorHarmonics", "SensorNoise", "STATE_NAMES", "INPUT_NAMES"]
 
@@ -63,10 +63,10 @@ INPUT_BLOCKS: dict[str, slice] = {
     "shear": slice(10, 12),
     "action": slice(12, 14),
     "hub": slice(14, 20),
-    "nonlinear": slice(20, 30),
-    "rotor": slice(30, 35),
+    "nonlinear": slice(20, 20 + N_DOF),
+    "rotor": slice(20 + N_DOF, 25 + N_DOF),
 }
-N_INPUT = 35
+N_INPUT = 25 + N_DOF
 INPUT_NAMES: tuple[str, ...] = (
     ("const", "wave_Fx", "wave_Fy", "wave_Fz", "wave_Mx", "wave_My", "wave_Mz", "wind_dev", "wave_elevation",
      "hub_wind", "shear_y", "shear_z", "pitch_offset", "torque_offset", "hub_Fx", "hub_Fy", "hub_Fz", "hub_Mx",
@@ -74,14 +74,15 @@ INPUT_NAMES: tuple[str, ...] = (
     + tuple(f"nl_{d}" for d in DOF_LABELS)
     + ("rotor_pitch", "rotor_generator_torque", "rotor_power", "rotor_thrust", "hub_wind_squared")
 )
-assert len(INPUT_NAMES) == N_INPUT and len(STATE_NAMES) == 22
+assert len(INPUT_NAMES) == N_INPUT and len(STATE_NAMES) == 2 * N_DOF + 2
 
 
 @dataclass(frozen=True)
 class RotorHarmonics:
     """Nominal amplitudes of the rotor harmonic loads (the ``rotor_3p`` and ``rotor_1p`` effects).
 
-    The 3P/6P terms (tower shadow and the mean shear seen by the blades, rigid-blade equivalent) are measured on
+    The 3P/6P terms (tower shadow and the mean shear seen by the blades, applied at the hub: OpenFAST's shaft loads
+    behind its flexible blades, so the simulation keeps them off the blades' flap mode) are measured on
     OpenFAST's OC3 Hywind deck in steady 12 m/s wind with shear exponent 0.2 (the shared run
     ``d_steady12_Hs2p5_Tp10``; amplitudes of ``RotThrust``, ``YawBrMyp/Mzp`` and ``LSShftTq`` demodulated at 3P
     and 6P against ``Azimuth``), as fractions of this model's aerodynamic thrust and torque at that point
@@ -189,7 +190,7 @@ class ModalResult:
         Damped natural frequencies (Hz).
     damping_ratios : ndarray
         Damping ratios (-).
-    shapes : ndarray, (10, n_modes)
+    shapes : ndarray, (N_DOF, n_modes)
         Real mode shapes in generalised coordinates, largest component +1.
     """
 
@@ -234,7 +235,7 @@ class LinearSystem:
     """The Morison drag strips with the equivalent linearisation held in ``A`` (and in the wave forcing)."""
 
     def equilibrium(self, nonlinear_force=None, tol: float = 1e-10) -> np.ndarray:
-        """Static equilibrium state under the mean loads (and an optional ``nonlinear_force(x) -> (10,)``)."""
+        """Static equilibrium state under the mean loads (and an optional ``nonlinear_force(x) -> (N_DOF,)``)."""
         a_qq = self.A[N_DOF:2 * N_DOF, :N_DOF]
         b_c = self.B[N_DOF:2 * N_DOF, 0]
         b_nl = self.B[N_DOF:2 * N_DOF, INPUT_BLOCKS["nonlinear"]]
@@ -401,6 +402,8 @@ class FOWTModel:
 
         m = st.mass
         k = st.stiffness + s_pd * st.stiffness_pdelta
+        # the turning blades' flap mode stiffens with the centrifugal tension (rotor speed of the operating point)
+        k[_FLAP, _FLAP] += st.data.n_blades * st.data.blade_flap.centrifugal * omega0**2
         # the spar's WAMIT radiation damping at the tower modes' frequencies (surrogates.radiation)
         c = st.damping + modal_radiation_damping(m, k)
         e_s = st.shaft_axis
@@ -597,8 +600,11 @@ class FOWTModel:
             tilt = st.data.shaft_tilt_rad
             rot_u[0] += -m_rot * GRAVITY * np.sin(tilt)  # tilt < 0: the weight pushes down the shaft
             rot_x[:N_DOF] += m_rot * GRAVITY * np.cos(tilt) * st.tower_top_rotation[1]
-            rot_x -= m_rot * h_v @ qdd_x
-            rot_u -= m_rot * h_v @ qdd_u
+            # inertia along the shaft: the rotor's mass with the hub, the blades' flap mode with int m phi
+            inertia = m_rot * h_v
+            inertia[_FLAP] = st.data.n_blades * st.data.blade_flap.first_moment
+            rot_x -= inertia @ qdd_x
+            rot_u -= inertia @ qdd_u
         rows_x["BldPitch1"], rows_u["BldPitch1"] = np.rad2deg(pitch_x), np.rad2deg(pitch_u)
         rows_x["GenTq"], rows_u["GenTq"] = gen_x / 1e3, gen_u / 1e3
         rows_x["GenPwr"], rows_u["GenPwr"] = pow_x / 1e3, pow_u / 1e3

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["OC3Data", "load_oc3", "GRAVITY", "RHO_WATER", "RHO_AIR", "WATER_DEPTH"]
+__all__ = ["OC3Data", "BladeFlapMode", "load_oc3", "GRAVITY", "RHO_WATER", "RHO_AIR", "WATER_DEPTH"]
 
 GRAVITY = 9.80665
 """Gravitational acceleration (m/s²), as in the OC3 ElastoDyn deck."""
@@ -34,6 +34,76 @@ WATER_DEPTH = 320.0
 
 # Jonkman 2010, section 5 ("additional linear damping" to match Statoil's Hywind data).
 EXTRA_LINEAR_DAMPING = np.diag([1.0e5, 1.0e5, 1.3e5, 0.0, 0.0, 1.3e7])
+
+
+@dataclass(frozen=True)
+class BladeFlapMode:
+    """Generalised properties of one blade's first flapwise bending mode (ElastoDyn's assumed mode).
+
+    The mode shape ``phi(x) = sum_k c_k x^k`` (``BldFl1Sh(2..6)``, ``x`` the fraction of the flexible span from
+    the root, ``phi(1) = 1``) scales the out-of-plane deflection: its coordinate is the tip deflection (m).
+
+    Attributes
+    ----------
+    mass : float
+        Generalised mass ``int m phi^2 dr`` (kg).
+    stiffness : float
+        Elastic generalised stiffness ``int EI_flap phi''^2 dr`` (N/m).
+    centrifugal : float
+        Centrifugal stiffening per squared rotor speed, ``int N(r) phi'^2 dr`` with ``N(r) = int_r^R m s ds``
+        (kg): the rotating blade's stiffness is ``stiffness + Omega^2 centrifugal``.
+    first_moment : float
+        ``int m phi dr`` (kg): couples the mode with the hub's motion along the shaft.
+    thrust_shape : float
+        Mode value at the thrust's centre, ``int phi r dr / int r dr`` (-) for a thrust growing linearly with
+        radius: the generalised force of the rotor thrust on the mode per newton, and the share of the tip's
+        flap velocity the blade's relative wind sees.
+    damping_ratio : float
+        Structural damping ratio (-), ``BldFlDmp(1)``.
+
+    Examples
+    --------
+    >>> mode = load_oc3().blade_flap  # NREL 5 MW: 0.68 Hz parked (Jonkman et al. 2009, Table 9-1: 0.67-0.70)
+    >>> bool(0.66 < mode.frequency_hz(0.0) < 0.70 and mode.frequency_hz(12.1) > mode.frequency_hz(0.0))
+    True
+    """
+
+    mass: float
+    stiffness: float
+    centrifugal: float
+    first_moment: float
+    thrust_shape: float
+    damping_ratio: float
+
+    def frequency_hz(self, rotor_rpm: float) -> float:
+        """Natural frequency of the blade's flap mode on a rigid hub (Hz) at a rotor speed (rpm)."""
+        omega = rotor_rpm * np.pi / 30.0
+        return float(np.sqrt((self.stiffness + omega**2 * self.centrifugal) / self.mass) / (2.0 * np.pi))
+
+
+def _blade_flap_mode(bl: dict[str, str], blade: np.ndarray, hub_r: float, tip: float) -> BladeFlapMode:
+    """The first flap mode's generalised properties from the ElastoDyn blade file (5-column table: ``BlFract,
+    StrcTwst, BMassDen, FlpStff, EdgStff``)."""
+    coeffs = np.array([_number(bl, f"BldFl1Sh({p})") for p in range(2, 7)])
+    powers = np.arange(2, 7)
+    length = tip - hub_r
+    x = np.linspace(0.0, 1.0, 2001)
+    r = hub_r + x * length
+    m = np.interp(x, blade[:, 0], blade[:, 2]) * _number(bl, "AdjBlMs")
+    ei = np.interp(x, blade[:, 0], blade[:, 3]) * _number(bl, "AdjFlSt") * _number(bl, "FlStTunr(1)")
+    phi = (coeffs[None, :] * x[:, None] ** powers).sum(axis=1)
+    d1 = (coeffs * powers * x[:, None] ** (powers - 1)).sum(axis=1) / length
+    d2 = (coeffs * powers * (powers - 1) * x[:, None] ** (powers - 2)).sum(axis=1) / length**2
+    tension = np.trapezoid(m * r, r) - np.concatenate([[0.0], np.cumsum(0.5 * (m[1:] * r[1:] + m[:-1] * r[:-1])
+                                                                         * np.diff(r))])
+    return BladeFlapMode(
+        mass=float(np.trapezoid(m * phi**2, r)),
+        stiffness=float(np.trapezoid(ei * d2**2, r)),
+        centrifugal=float(np.trapezoid(tension * d1**2, r)),
+        first_moment=float(np.trapezoid(m * phi, r)),
+        thrust_shape=float(np.trapezoid(phi * r, r) / np.trapezoid(r, r)),
+        damping_ratio=_number(bl, "BldFlDmp(1)") / 100.0,
+    )
 
 
 @dataclass(frozen=True)
@@ -66,6 +136,8 @@ class OC3Data:
         Second moment of one blade's mass about the rotor apex, ∫ m r² dr (kg·m²).
     blade_first_moment : float
         First moment of one blade's mass about the rotor apex, ∫ m r dr (kg·m).
+    blade_flap : BladeFlapMode
+        One blade's first flapwise mode (ElastoDyn's ``BldFl1Sh`` polynomial, ``FlpStff``, ``BldFlDmp(1)``).
     n_blades : int
     tip_radius, hub_radius : float
         Rotor radius and blade-root radius (m).
@@ -106,6 +178,7 @@ class OC3Data:
     blade_mass: float
     blade_second_moment: float
     blade_first_moment: float
+    blade_flap: BladeFlapMode
     n_blades: int
     tip_radius: float
     hub_radius: float
@@ -280,6 +353,7 @@ def load_oc3() -> OC3Data:
         blade_mass=blade_mass,
         blade_second_moment=blade_second,
         blade_first_moment=blade_first,
+        blade_flap=_blade_flap_mode(bl, blade, hub_r, tip),
         n_blades=int(_number(ed, "NumBl")),
         tip_radius=tip,
         hub_radius=hub_r,

@@ -685,8 +685,10 @@ def replay_forcing(sim: Simulator, n_steps: int, t_start: float, waves: Measured
                 b = blade_effective_wind(b[:, None, :], np.array([1.0]), np.arange(b.shape[1]) * 2 * np.pi
                                          / b.shape[1], N_BLADE_AZIMUTH)
             blade = np.empty((n, N_BLADE_AZIMUTH), dtype=np.float32)
+            # each azimuth of the tilted disc meets the field with its own delay (Simulator.blade_sampling_delay)
+            delay = sim.blade_sampling_delay(lc.wind_speed if lc.wind_speed > 0 else wind.mean_speed())
             for j in range(N_BLADE_AZIMUTH):
-                blade[:, j] = np.interp(tw, wind.t, b[:, j])
+                blade[:, j] = np.interp(tw - delay[j], wind.t, b[:, j])
         else:
             blade = np.zeros((0, N_BLADE_AZIMUTH), dtype=np.float32)
     return np.ascontiguousarray(u_ex), vel, psi0, np.ascontiguousarray(blade)

@@ -465,8 +465,9 @@ class ReplayForcing:
                 blade = blade_effective_wind(blade[:, None, :], np.array([1.0]),
                                              np.arange(blade.shape[1]) * 2 * np.pi / blade.shape[1], N_BLADE_AZIMUTH)
             b = np.empty((t.size, N_BLADE_AZIMUTH), dtype=np.float32)
+            delay = self.sim.blade_sampling_delay(self.sim.case.wind_speed)  # the tilted disc: see Simulator
             for j in range(N_BLADE_AZIMUTH):
-                b[:, j] = np.interp(t, t_rows, blade[:, j])
+                b[:, j] = np.interp(t - delay[j], t_rows, blade[:, j])
             inter.append(b)
         else:
             inter.append(None)
@@ -494,7 +495,9 @@ class ReplayForcing:
         # one read per distinct series for both uses (a record often carries waves and wind)
         wv, wd = self.waves, self.wind
         ra = self._rows(wv.series, float(t[0]), float(t[-1]), wv.margin_s)
-        margin_wind = wd.margin_s if wd.level == "hub" else 0.0
+        # pointwise levels need no margin, but the blade winds are read up to the tilted disc's sampling delays
+        margin_wind = (wd.margin_s if wd.level == "hub"
+                       else float(np.max(np.abs(sim.blade_sampling_delay()))) + wd.series.dt)
         tw = t - self.wind_delay  # the wind the rotor meets now passed the measurement plane at tw
         rb = self._rows(wd.series, float(tw[0]), float(tw[-1]), margin_wind)
         if wv.series is wd.series:

@@ -43,6 +43,7 @@ from .model import (
 from .mooring import mooring_loads, mooring_table
 from .oc3 import RHO_AIR
 from .record import Record
+from .structure import _FLAP as FLAP
 from .structure import N_DOF
 from .validation import check_number
 from .waves import synthesize_waves
@@ -134,7 +135,7 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
            moor_jac, moor_out, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab, cq_tab, par, u):
     """Fill u[10:] (actions, hub loads, nonlinear generalised forces, rotor outputs) from the state at the start
     of a step; return the rotor acceleration (rad/s^2, 0 when the rotor is linear or parked)."""
-    nd = 10
+    nd = N_DOF
     hub0 = I_HUB
     nl0 = I_NL
     rot0 = I_ROTOR
@@ -295,6 +296,10 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         u[hub0 + 2] += cent * c1
         u[hub0 + 4] += tr * (-harm[7] * c3 + harm[9] * c1)
         u[hub0 + 5] += tr * (harm[11] * s3 + harm[9] * s1)
+        # the harmonic amplitudes are OpenFAST's shaft loads, measured behind its flexible blades: they act on the
+        # hub, not through the blades' flap mode (which the hub-load block would also drive, by h_v[FLAP])
+        f_shaft = fs + (cent * s1 - t0 * harm[12] * c3) * e_s[1] + cent * c1 * e_s[2]
+        u[nl0 + FLAP] -= h_v[FLAP] * f_shaft
     return domega
 
 
@@ -341,14 +346,14 @@ def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, v
             for i in range(n_r):
                 acc += g_rest[r, i] * u[N_EX + i]
             xn[r] = acc
-        psi += (harm[3] + x[20]) * dt
+        psi += (harm[3] + x[2 * N_DOF]) * dt
         for i in range(3):  # heave, roll, pitch accelerations over the step, for the next step's CM kinematics
             ctrl[I_ACC + i] = (xn[N_DOF + 2 + i] - x[N_DOF + 2 + i]) / dt
         for r in range(n_x):
             x[r] = xn[r]
         if rotor:
-            x[20] += domega * dt
-            discon_step(discon, ctrl, par[P_NGEAR] * (par[P_OMEGA0] + x[20]), dt)
+            x[2 * N_DOF] += domega * dt
+            discon_step(discon, ctrl, par[P_NGEAR] * (par[P_OMEGA0] + x[2 * N_DOF]), dt)
     return psi
 
 
@@ -601,6 +606,34 @@ class Simulator:
                         self.harm, self.e_s, self.h_v, self.r_pitch, *self.rotor_grids, self.discon, self.par,
                         x_hist, u_hist, out0)
 
+    def blade_sampling_delay(self, mean_speed: float | None = None) -> np.ndarray:
+        """Delay (s) with which the blade at each of the ``N_BLADE_AZIMUTH`` azimuths meets the turbulence that
+        crosses the rotor centre.
+
+        The disc is tilted by the shaft tilt plus the equilibrium pitch of the tower top (~9-10 deg at rated):
+        its upper half sits downwind of the centre and its lower half upwind, by ``r cos(psi) sin(chi)``, and a
+        frozen field advected at the mean speed ``U`` reaches each point that much later or earlier. At the
+        radius-weighted blade's mean radius ``2R/3`` that is +-0.5 s at 12 m/s: OpenFAST's InflowWind samples the
+        field at each blade node's own position, so the rotationally sampled turbulence must see the same delays.
+
+        Parameters
+        ----------
+        mean_speed : float, optional
+            Advection speed (m/s); default the load case's mean wind speed.
+
+        Returns
+        -------
+        ndarray (N_BLADE_AZIMUTH,)
+            Delays (s) at azimuths ``j 2 pi / N`` from the top towards +y; zeros without wind.
+        """
+        speed = self.case.wind_speed if mean_speed is None and self.case is not None else mean_speed
+        if speed is None or not speed > 0.1:
+            return np.zeros(N_BLADE_AZIMUTH)
+        st = self.system.structure
+        chi = float(st.tower_top_rotation[1] @ self.x_eq[:N_DOF]) - st.data.shaft_tilt_rad  # nose-up tilt (rad)
+        psi = np.arange(N_BLADE_AZIMUTH) * 2.0 * np.pi / N_BLADE_AZIMUTH
+        return (2.0 / 3.0) * st.data.tip_radius * np.cos(psi) * np.sin(chi) / float(speed)
+
     def forcing(self, n_steps: int, seed_sequence: np.random.SeedSequence
                 ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
         """Exogenous inputs for ``n_steps`` internal steps (+1 sample for the hold), strip velocities, initial
@@ -635,15 +668,17 @@ class Simulator:
             w_r = np.where(radii > 0, radii, 0.0)
             w_r /= w_r.sum()
             on_blade = np.einsum("tra,r->ta", wd.polar_u, w_r)  # (n_field, n_azimuth)
-            idx = t / FIELD_DT
+            # each azimuth meets the frozen field with its own delay (the disc is tilted: blade_sampling_delay)
+            idx = np.clip((t[:, None] - self.blade_sampling_delay()[None, :]) / FIELD_DT, 0.0, None)
             i0 = np.minimum(idx.astype(int), on_blade.shape[0] - 2)
-            frac = (idx - i0)[:, None]
-            blade = ((1.0 - frac) * on_blade[i0] + frac * on_blade[i0 + 1]).astype(np.float32)
+            frac = idx - i0
+            cols = np.arange(on_blade.shape[1])[None, :]
+            blade = ((1.0 - frac) * on_blade[i0, cols] + frac * on_blade[i0 + 1, cols]).astype(np.float32)
         psi0 = float(np.random.default_rng(psi_ss).uniform(0.0, 2.0 * np.pi))
         return np.ascontiguousarray(u_ex), vel, psi0, np.ascontiguousarray(blade)
 
     def exogenous(self, u_ex: np.ndarray) -> np.ndarray:
-        """Contribution of the exogenous inputs (first-order hold) to each next state, shape (n_steps, 22)."""
+        """Contribution of the exogenous inputs (first-order hold) to each next state, shape (n_steps, N_STATE)."""
         return np.ascontiguousarray(u_ex[:-1] @ self.g_ex0.T + u_ex[1:] @ self.g_ex1.T)
 
     def outputs(self, x_hist: np.ndarray, u_ex_out: np.ndarray, u_hist: np.ndarray) -> np.ndarray:

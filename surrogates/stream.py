@@ -242,7 +242,7 @@ class StreamingSimulator:
 
     @property
     def state(self) -> np.ndarray:
-        """Current state vector (22,), a copy."""
+        """Current state vector (N_STATE,), a copy."""
         return self.x.copy()
 
     @property

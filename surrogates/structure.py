@@ -33,10 +33,12 @@ __all__ = ["DOF_LABELS", "N_DOF", "Structure", "build_structure", "RigidBody"]
 
 DOF_LABELS: tuple[str, ...] = (
     "surge", "sway", "heave", "roll", "pitch", "yaw", "tower_fa_1", "tower_fa_2", "tower_ss_1", "tower_ss_2",
+    "blade_flap",
 )
 N_DOF = len(DOF_LABELS)
 _FA = (6, 7)
 _SS = (8, 9)
+_FLAP = 10  # collective first flap mode of the blades: tip deflection along the shaft (m)
 
 
 def _skew(p: np.ndarray) -> np.ndarray:
@@ -116,7 +118,8 @@ class Structure:
     tower_top_rotation : ndarray, (3, N_DOF)
         Rotation Jacobian of the tower top.
     hub_translation : ndarray, (3, N_DOF)
-        Translation Jacobian of the rotor apex.
+        Translation Jacobian of the rotor apex; its ``blade_flap`` column is where the rotor thrust acts on the
+        flexible blades (the flap mode's value at the thrust's centre, along the shaft).
     shaft_axis : ndarray, (3,)
         Unit vector along the shaft, pointing downwind (tilted by the shaft tilt).
     hub_position : ndarray, (3,)
@@ -266,11 +269,12 @@ def build_structure(n_tower_strips: int = 80, n_fe_elements: int = 40) -> Struct
             RigidBody("tower", float(m), np.array([0, 0, zc_]), np.zeros((3, 3)),
                       _translation(shapes, zc_, np.zeros(3)), _rotation(shapes, zc_))
         )
+    flap = d.blade_flap
     for name, m, off, iner in rna_parts:
-        bodies.append(
-            RigidBody(name, float(m), np.array([0, 0, z1]) + off, iner,
-                      _translation(shapes, z1, np.asarray(off, float)), _rotation(shapes, z1))
-        )
+        t_body = _translation(shapes, z1, np.asarray(off, float))
+        if name == "blades":  # the blades' centre of mass follows their collective flap deflection
+            t_body[:, _FLAP] = shaft * flap.first_moment / d.blade_mass
+        bodies.append(RigidBody(name, float(m), np.array([0, 0, z1]) + off, iner, t_body, _rotation(shapes, z1)))
 
     # --- platform
     p_cm = np.array([0.0, 0.0, d.platform_cm_z])
@@ -285,6 +289,8 @@ def build_structure(n_tower_strips: int = 80, n_fe_elements: int = 40) -> Struct
     for b in bodies:
         mass += b.mass * b.translation.T @ b.translation + b.rotation.T @ b.inertia @ b.rotation
     mass[:6, :6] += d.added_mass
+    # the blades' flap mode carries int m phi^2 (the lumped body above holds only its centre of mass' share)
+    mass[_FLAP, _FLAP] += d.n_blades * (flap.mass - flap.first_moment**2 / d.blade_mass)
 
     r_top = _rotation(shapes, z1)
     n_gear = d.gearbox_ratio
@@ -301,6 +307,7 @@ def build_structure(n_tower_strips: int = 80, n_fe_elements: int = 40) -> Struct
         k[np.ix_(idx, idx)] += np.trapezoid(ei[None, None, :] * rows[:, None, :] * rows[None, :, :], zq, axis=-1)
     k[3, 3] += -d.platform_mass * GRAVITY * d.platform_cm_z
     k[4, 4] += -d.platform_mass * GRAVITY * d.platform_cm_z
+    k[_FLAP, _FLAP] += d.n_blades * flap.stiffness  # parked; the model adds the centrifugal stiffening
 
     # --- gravity geometric (P-delta) stiffness of everything above SWL: each weight m at height h drops by
     #     (1/2) int_0^h |s(z)|^2 dz when the column tilts and bends, s the slope vector.
@@ -335,6 +342,12 @@ def build_structure(n_tower_strips: int = 80, n_fe_elements: int = 40) -> Struct
         m_ii = sum(b.mass * b.translation[:, i] @ b.translation[:, i] for b in bodies if b.name.startswith("tower"))
         k_ii = k[i, i]
         c[i, i] = 2.0 * zeta * np.sqrt(max(k_ii, 0.0) * m_ii)
+    # ElastoDyn's blade damping: zeta of the blade's own mode on a rigid hub (parked stiffness)
+    c[_FLAP, _FLAP] = 2.0 * flap.damping_ratio * d.n_blades * np.sqrt(flap.stiffness * flap.mass)
+    # the rotor thrust acts on the blades: along the shaft at the hub, and on the flap mode through the mode's
+    # value at the thrust's centre -- which is also the share of the flap velocity in the blades' relative wind
+    hub_translation = _translation(shapes, z1, apex)
+    hub_translation[:, _FLAP] = shaft * flap.thrust_shape
 
     return Structure(
         data=d,
@@ -348,7 +361,7 @@ def build_structure(n_tower_strips: int = 80, n_fe_elements: int = 40) -> Struct
         gravity_load=gravity_load,
         bodies=tuple(bodies),
         tower_top_rotation=r_top,
-        hub_translation=_translation(shapes, z1, apex),
+        hub_translation=hub_translation,
         shaft_axis=shaft,
         hub_position=np.array([0.0, 0.0, z1]) + apex,
     )

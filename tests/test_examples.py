@@ -101,6 +101,8 @@ def test_02_modes_are_the_models_and_near_the_oc3_reference(lesson):
     assert r["frequencies_hz"]["tower_ss_1"] == pytest.approx(0.492, rel=0.05)
     assert r["frequencies_hz"]["pitch"] == pytest.approx(0.0343, rel=0.05)
     assert r["frequencies_hz"]["heave"] == pytest.approx(0.0324, rel=0.05)
+    # the blades' 1st collective flap mode, parked: FAST's 0.6993 Hz (Jonkman et al. 2009, Table 9-1)
+    assert r["frequencies_hz"]["blade_flap"] == pytest.approx(0.6993, rel=0.03)
     # Aerodynamic damping = the operating point against itself with aero_damping off. (Was: against parked, but
     # the Morison drag is now linearised about each sea state's response, so the platform is damped more by
     # the water in waves too, and the rotor is under the DISCON controller, whose sign flips at rated.)

@@ -320,7 +320,9 @@ def scenario_scores(surrogates, model, sensor, name, duration, seed=7, return_er
 def spar():
     surrogates = pytest.importorskip("surrogates")
     model = surrogates.FOWTModel()
-    sensor = fit_surrogate_sensor(surrogates, model, (1, 6, 11), duration=200.0, em_iter=5)
+    # rank 48 (default 40): the surrogate's blades' flap mode (two more states, coupled with the tower) took the
+    # 95 % coverage of the lowest gauge from 0.89 to 0.65 at rank 40; rank 48 gives [0.91, 0.92, 0.82, 0.88]
+    sensor = fit_surrogate_sensor(surrogates, model, (1, 6, 11), duration=200.0, em_iter=5, rank=48)
     noisy, truth = surrogates.simulate(model, 7, duration=60.0, seed=21, return_truth=True)
     return surrogates, model, sensor, noisy.planar("FA").y, truth.planar("FA").y
 

@@ -79,11 +79,18 @@ def test_replayed_forcing_equals_the_synthesised_forcing():
     hub = u_ex[:, INPUT_BLOCKS["hub_wind"].start]
     eff = u_ex[:, INPUT_BLOCKS["wind"].start] + lc.wind_speed
     shear = u_ex[:, INPUT_BLOCKS["shear"]]
-    wind = MeasuredWind(t, hub, eff, shear[:, 0], shear[:, 1], blade, level="field", x_ref=None)  # drawn at the rotor
+    # the blades meet the field with the tilted disc's per-azimuth delays (Simulator.blade_sampling_delay, +-0.5 s
+    # at 12 m/s); a measured field is the one crossing the rotor centre's plane: undo them to get it back
+    delay = sim.blade_sampling_delay()
+    assert 0.3 < delay[0] < 0.7 and delay[0] == pytest.approx(-delay[delay.size // 2])
+    plane = np.stack([np.interp(t + d, t, blade[:, j]) for j, d in enumerate(delay)], axis=1).astype(np.float32)
+    wind = MeasuredWind(t, hub, eff, shear[:, 0], shear[:, 1], plane, level="field", x_ref=None)  # drawn at the rotor
     u2, v2, p2, b2 = replay_forcing(sim, n_steps, 0.0, MeasuredWaves(t, elev), wind,
                                     np.random.SeedSequence(3).spawn(2)[0])
     assert p2 == psi0
-    assert np.array_equal(b2, blade)
+    inner = slice(int(1.0 / sim.dt_int), -int(1.0 / sim.dt_int))  # away from the ends the shifts clamp at
+    err = b2[inner] - blade[inner]  # two linear interpolations of a field sampled at 0.05 s
+    assert np.std(err) < 0.005 * np.std(blade) and np.max(np.abs(err)) < 0.05 * np.std(blade)
     for j in (7, 9, 10, 11):
         assert np.allclose(u2[:, j], u_ex[:, j])
     mid = slice(int(20 / sim.dt_int), int(180 / sim.dt_int))
@@ -240,13 +247,13 @@ def test_bts_reader_and_field_reduction(tmp_path):
 
 
 # issue 16's target on the shared turbulent runs: R^2 >= 0.85 x the multiple-coherence bound for these channels in
-# the wave band and over 0-1 Hz, and >= 0.9 in the wave band for the fore-aft tower. The three misses measured on
-# this physics (README, "Replay measured conditions": the 1st tower mode band's rotationally sampled turbulence is
-# azimuth-phase sensitive) are held to floors instead, so that they cannot get worse unseen.
+# the wave band and over 0-1 Hz, and >= 0.9 in the wave band for the fore-aft tower. The two misses measured on
+# this physics (README, "Replay measured conditions": in the 1st tower mode band the replay leads OpenFAST by ~90 deg
+# at every frequency) are held to floors instead, so that they cannot get worse unseen. (8 m/s TwrBsMyt 0-1 Hz
+# was a third, 0.65; the blades' flap mode lifted it to 0.69 against 0.68.)
 REPLAY_TARGET_CHANNELS = ("PtfmSurge", "PtfmHeave", "PtfmPitch", "TwrBsMyt", "TwHt9ALxt", "RotSpeed", "BldPitch1")
-REPLAY_KNOWN_MISSES = {("c_op08_Hs2p0_Tp9", "TwrBsMyt", "0-1 Hz"): 0.6,
-                       ("c_op08_Hs2p0_Tp9", "TwHt9ALxt", "0-1 Hz"): 0.35,
-                       ("c_op12_Hs2p5_Tp10", "TwHt9ALxt", "0-1 Hz"): 0.4}
+REPLAY_KNOWN_MISSES = {("c_op08_Hs2p0_Tp9", "TwHt9ALxt", "0-1 Hz"): 0.4,
+                       ("c_op12_Hs2p5_Tp10", "TwHt9ALxt", "0-1 Hz"): 0.38}
 
 
 @pytest.mark.slow
