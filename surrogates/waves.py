@@ -372,8 +372,10 @@ def _along_loads(
         z, dz, diam = geo.strips(_check_strips("n_strips", n_strips))
     area = np.pi / 4.0 * diam**2
     horizontal, _ = _kernels(k, z, depth)
-    if diffraction:  # strip by strip, with the local radius
-        horizontal = horizontal * maccamy_fuchs_factor(0.5 * k[:, None] * diam[None, :])
+    if diffraction:  # strip by strip, with the local radius (evaluated once per distinct diameter: the columns
+        # above and below the taper share theirs, and the Bessel functions are most of this function's time)
+        unique_diam, which = np.unique(diam, return_inverse=True)
+        horizontal = horizontal * maccamy_fuchs_factor(0.5 * k[:, None] * unique_diam[None, :])[:, which]
     # eta = Re(a e^{i w t}) on the axis: u = w a K(z) cos(w t), du/dt = Re(i w^2 a K(z) e^{i w t})
     section = (RHO_WATER * (1.0 + geo.ca)) * area * dz
     scale = 1j * w**2
