@@ -2,7 +2,7 @@
 
 State ``x`` (24): generalised displacements ``q`` (11, see :data:`surrogates.structure.DOF_LABELS`), their
 rates, the rotor-speed deviation ``dOmega`` (rad/s) and the integral of it ``xi`` (rad, the pitch controller's
-integrator). Inputs ``u`` (28), in blocks:
+integrator). Inputs ``u`` (36), in blocks:
 
 =========  =====  ===========================================================================
 block      size   meaning (SI)
@@ -627,8 +627,9 @@ class FOWTModel:
         Returns
         -------
         ModalResult
-            The 10 structural modes, labelled ``surge`` ... ``yaw``, ``tower_fa_1``, ``tower_ss_1``,
-            ``tower_fa_2``, ``tower_ss_2``, sorted by frequency.
+            The 11 structural modes, labelled ``surge`` ... ``yaw``, ``tower_fa_1``, ``tower_ss_1``,
+            ``blade_flap``, ``tower_fa_2``, ``tower_ss_2``, sorted by frequency (an overdamped mode: its undamped
+            frequency, damping ratio 1).
         """
         sys = self.system(case)
         st = self.structure
@@ -649,9 +650,11 @@ class FOWTModel:
             * np.real(np.einsum("ij,ij->j", vec.conj(), st.mass @ vec))[None, :]
         )
         rows, cols = linear_sum_assignment(-mac)
-        freqs = np.empty(N_DOF)
-        zetas = np.empty(N_DOF)
-        shapes = np.empty((N_DOF, N_DOF))
+        # a mode left without an oscillating eigenvalue is overdamped (the operating rotor's blade flap can be):
+        # its undamped frequency and shape, damping ratio 1 (at least)
+        freqs = np.sqrt(np.maximum(w2, 0.0)) / (2 * np.pi)
+        zetas = np.ones(N_DOF)
+        shapes = phi / np.max(np.abs(phi), axis=0, keepdims=True)
         for r, cidx in zip(rows, cols, strict=True):
             ev = lam[cidx]
             freqs[r] = abs(ev.imag) / (2 * np.pi)

@@ -36,7 +36,7 @@ import numpy as np
 from .drag import DragStrips, drag_strips
 from .model import FOWTModel, SensorNoise
 from .oc3 import GRAVITY
-from .structure import N_DOF, Structure, build_structure
+from .structure import Structure, build_structure
 
 __all__ = ["Parameter", "PARAMETERS", "ParametricModel", "as_parametric", "resolve_parameters",
            "scaled_structure", "scaled_drag", "line_tangent_stiffness"]
@@ -189,7 +189,7 @@ def scaled_structure(structure: Structure, parameters: Mapping[str, float]) -> S
         k[block] *= s
         for i in idx:
             c[i, i] *= np.sqrt(s)
-    for i in range(6, N_DOF):
+    for i in (6, 7, 8, 9):  # the four tower modes (the blades' flap keeps its own damping)
         c[i, i] *= p["structural_damping"]
     return replace(structure, mass=0.5 * (mass + mass.T), stiffness=0.5 * (k + k.T), damping=c)
 

@@ -85,6 +85,8 @@ __all__ = [
     "as_measured_waves",
     "as_measured_wind",
     "blade_effective_wind",
+    "measured_azimuth",
+    "with_measured_azimuth",
     "polar_from_grid",
     "replay_forcing",
     "replay_window",
@@ -573,7 +575,7 @@ def advection_delay(sim: Simulator, wind: MeasuredWind | None = None, *, x_ref: 
     mean_speed : float, optional
         Advection speed (m/s); default the simulator's load case's wind speed, else ``wind``'s mean hub speed.
     """
-    from .structure import N_DOF
+    from .structure import _FLAP
 
     if wind is not None:
         x_ref = wind.x_ref
@@ -583,7 +585,9 @@ def advection_delay(sim: Simulator, wind: MeasuredWind | None = None, *, x_ref: 
         mean_speed = sim.case.wind_speed if sim.case is not None and sim.case.wind_speed > 0 else (
             wind.mean_speed() if wind is not None else 0.0)
     st = sim.system.structure
-    x_rotor = float(st.hub_position[0] + st.hub_translation[0] @ sim.x_eq[:N_DOF])
+    # the rotor apex (the blades' flap deflection downwind and their precone upwind nearly cancel at the thrust
+    # centre: +1.8 and -1.8 m at 12 m/s)
+    x_rotor = float(st.hub_position[0] + st.hub_translation[0, :_FLAP] @ sim.x_eq[:_FLAP])
     return (x_rotor - float(x_ref)) / max(float(mean_speed), 0.1)
 
 
@@ -639,6 +643,48 @@ def replay_window(waves: MeasuredWaves | None, wind: MeasuredWind | None, durati
         raise ValueError(f"the replayed inputs cover {t1 - t0:g} s from t = {t0:g} s: too short for transient "
                          f"{transient:g} s + duration {duration:g} s (at most duration={max(avail, 0):.6g})")
     return t0, duration
+
+
+def measured_azimuth(azimuth: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``(t, psi)`` of a measured rotor azimuth: a record with an ``Azimuth`` channel or a ``(t, deg)`` pair.
+
+    Returns the time (s) and the azimuth unwrapped to a continuous angle (rad), OpenFAST's convention (blade 1 up
+    = 0, increasing clockwise looking downwind).
+
+    Raises
+    ------
+    ValueError
+        No ``Azimuth`` channel, mismatched or non-finite arrays, a time axis not increasing.
+    """
+    if hasattr(azimuth, "channels") and hasattr(azimuth, "t"):
+        if "Azimuth" not in azimuth.channels:
+            raise ValueError("the record has no Azimuth channel to replay")
+        t, deg = np.asarray(azimuth.t, float), np.asarray(azimuth["Azimuth"], float)
+    else:
+        try:
+            t, deg = (np.asarray(a, dtype=float) for a in azimuth)
+        except (TypeError, ValueError):
+            raise ValueError("azimuth must be a record with an Azimuth channel or a (t, deg) pair") from None
+    if t.ndim != 1 or t.shape != deg.shape or t.size < 2:
+        raise ValueError(f"azimuth needs matching 1-D time and angle arrays of >= 2 samples, got {t.shape}, "
+                         f"{deg.shape}")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(deg))):
+        raise ValueError("azimuth: non-finite time or angle")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("azimuth: time must increase")
+    return t, np.unwrap(np.deg2rad(deg))
+
+
+def with_measured_azimuth(blade: np.ndarray, t: np.ndarray, t_az: np.ndarray, psi_az: np.ndarray) -> np.ndarray:
+    """The stepper's blade-wind array with the measured azimuth (rad, wrapped) as an extra last column at the
+    internal steps' times ``t`` (NaN outside the measurement: the stepper then integrates its own); a forcing
+    without a turbulent field gets NaN blade winds (the stepper then computes no rotationally sampled loads)."""
+    from .simulate import N_BLADE_AZIMUTH
+
+    psi = np.interp(t, t_az, psi_az, left=np.nan, right=np.nan) % (2.0 * np.pi)
+    field = blade if blade.shape[0] == t.size else np.full((t.size, N_BLADE_AZIMUTH), np.nan)
+    return np.ascontiguousarray(np.concatenate([field[:, :N_BLADE_AZIMUTH], psi[:, None]], axis=1),
+                                dtype=np.float32)
 
 
 def replay_forcing(sim: Simulator, n_steps: int, t_start: float, waves: MeasuredWaves | None,

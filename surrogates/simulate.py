@@ -221,7 +221,7 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         # damping of tilt and yaw (aero_damping)
         s_asym = par[P_SASYM]
         s_rot = par[P_SAERO] if par[P_RS] > 0.0 else 0.0
-        has_field = s_asym > 0.0 and blade.shape[0] > k
+        has_field = s_asym > 0.0 and blade.shape[0] > k and blade[k, 0] == blade[k, 0]  # NaN: azimuth only
         if has_field or s_rot > 0.0:
             mt = 0.0
             my = 0.0
@@ -233,7 +233,7 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 s_b = math.sin(psi_b)
                 dv = -s_rot * (rate_y * par[P_RS] * c_b + rate_z * par[P_RS] * s_b)  # blade at r_s (-sin, cos)
                 if has_field:
-                    n_az = blade.shape[1]
+                    n_az = N_BLADE_AZIMUTH
                     d_az = 2.0 * math.pi / n_az
                     phi = (-psi_b) % (2.0 * math.pi)  # the blade's azimuth from the top towards +y
                     fa = phi / d_az
@@ -325,8 +325,13 @@ def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, v
     dt = par[P_DT]
     rotor = par[P_ROTOR] > 0.0
     moor_out = np.zeros(12)
+    measured_azimuth = blade.shape[1] > N_BLADE_AZIMUTH
     for step in range(n_steps):
         k = k0 + step
+        if measured_azimuth and blade.shape[0] > k:  # a replay of the rotor's measured azimuth (rad; NaN: none)
+            a = blade[k, N_BLADE_AZIMUTH]
+            if a == a:
+                psi = a
         domega = _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_along, drag_across,
                         drag_dir,
                         moor_gx, moor_gy, moor_gyaw,
@@ -613,8 +618,9 @@ class Simulator:
         The disc is tilted by the shaft tilt plus the equilibrium pitch of the tower top (~9-10 deg at rated):
         its upper half sits downwind of the centre and its lower half upwind, by ``r cos(psi) sin(chi)``, and a
         frozen field advected at the mean speed ``U`` reaches each point that much later or earlier. At the
-        radius-weighted blade's mean radius ``2R/3`` that is +-0.5 s at 12 m/s: OpenFAST's InflowWind samples the
-        field at each blade node's own position, so the rotationally sampled turbulence must see the same delays.
+        radius of the radius-weighted blade wind (``BLADE_SAMPLING_RADIUS``, 0.75 R) that is +-0.6 s at 12 m/s:
+        OpenFAST's InflowWind samples the field at each blade node's own position, so the rotationally sampled
+        turbulence must see the same delays.
 
         Parameters
         ----------
@@ -632,7 +638,7 @@ class Simulator:
         st = self.system.structure
         chi = float(st.tower_top_rotation[1] @ self.x_eq[:N_DOF]) - st.data.shaft_tilt_rad  # nose-up tilt (rad)
         psi = np.arange(N_BLADE_AZIMUTH) * 2.0 * np.pi / N_BLADE_AZIMUTH
-        return (2.0 / 3.0) * st.data.tip_radius * np.cos(psi) * np.sin(chi) / float(speed)
+        return BLADE_SAMPLING_RADIUS * st.data.tip_radius * np.cos(psi) * np.sin(chi) / float(speed)
 
     def forcing(self, n_steps: int, seed_sequence: np.random.SeedSequence
                 ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
@@ -669,7 +675,8 @@ class Simulator:
             w_r /= w_r.sum()
             on_blade = np.einsum("tra,r->ta", wd.polar_u, w_r)  # (n_field, n_azimuth)
             # each azimuth meets the frozen field with its own delay (the disc is tilted: blade_sampling_delay)
-            idx = np.clip((t[:, None] - self.blade_sampling_delay()[None, :]) / FIELD_DT, 0.0, None)
+            idx = np.clip((t[:, None] - self.blade_sampling_delay()[None, :]) / FIELD_DT, 0.0,
+                          on_blade.shape[0] - 1.0)  # held at the field's ends, as np.interp does in a replay
             i0 = np.minimum(idx.astype(int), on_blade.shape[0] - 2)
             frac = idx - i0
             cols = np.arange(on_blade.shape[1])[None, :]
@@ -718,6 +725,7 @@ def simulate(
     initial: Mapping[str, float] | None = None,
     waves: object = None,
     wind: object = None,
+    azimuth: object = None,
     on_progress: Callable[[float], None] | None = None,
 ) -> Record | list[Record]:
     """Simulate the surrogate under a load case and return its 45 sensor channels.
@@ -759,6 +767,13 @@ def simulate(
         hub series) instead of the turbulence draw; the case's ``wind_speed`` is the linearisation point (use
         the measured mean). With replayed inputs the simulation starts at the latest start of their time axes
         and the returned record's time stamps are theirs (``transient`` later).
+    azimuth : Record or (t, deg), optional
+        With ``waves``/``wind``: the rotor's measured azimuth (a record's ``Azimuth``, deg, OpenFAST's
+        convention), which then places the blades in the turbulent field and sets the phase of the 3P/6P loads
+        at every step instead of the azimuth integrated from the simulated rotor speed (outside its time span
+        the simulated one continues). The rotationally sampled loads are phase-locked to the blades: a rotor
+        speed 0.1 % off shifts their 3P phase by ~90° within ten minutes, so a twin replays the measured azimuth
+        as it replays the measured wind. The rotor speed stays the simulation's own.
     on_progress : callable, optional
         A progress bar's hook: called with the simulated seconds (transient included) just integrated, about
         every 1 % of each seed's run; ``(duration + transient) * n_seeds`` seconds in all. With several seeds it
@@ -778,18 +793,23 @@ def simulate(
     if not np.isfinite(transient) or transient < 0:
         raise ValueError(f"transient must be finite and >= 0 (s), got {transient!r}")
     replay = waves is not None or wind is not None
+    if azimuth is not None and not replay:
+        raise ValueError("azimuth replays a measured rotor azimuth alongside measured waves or wind (waves=, wind=)")
     if replay:
         from .replay import (
             advection_delay,
             as_measured_waves,
             as_measured_wind,
+            measured_azimuth,
             replay_forcing,
             replay_meta,
             replay_window,
+            with_measured_azimuth,
         )
 
         waves = None if waves is None else as_measured_waves(waves)
         wind = None if wind is None else as_measured_wind(wind)
+        az_series = None if azimuth is None else measured_azimuth(azimuth)
         if duration is not None:
             duration = check_number("duration", duration, positive=True)
         t_start, duration = replay_window(waves, wind, duration, transient, dt)
@@ -818,6 +838,8 @@ def simulate(
     def run_one(forcing_seq: np.random.SeedSequence) -> np.ndarray:
         if replay:
             u_ex, vel, psi0, blade = replay_forcing(sim, n_steps, t_start, waves, wind, forcing_seq)
+            if az_series is not None:
+                blade = with_measured_azimuth(blade, t_start + np.arange(n_steps + 1) * sim.dt_int, *az_series)
         else:
             u_ex, vel, psi0, blade = sim.forcing(n_steps, forcing_seq)
         if psi_start is not None:

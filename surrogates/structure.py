@@ -5,6 +5,8 @@ Generalised coordinates ``q`` (SI, small angles in rad)::
     0 surge  1 sway  2 heave  3 roll  4 pitch  5 yaw      rigid platform, about the reference point at still
                                                            water level (SWL)
     6 tower_fa_1  7 tower_fa_2  8 tower_ss_1  9 tower_ss_2 tower modal amplitudes (m of tower-top deflection)
+    10 blade_flap                                          the blades' collective first flap mode (m of tip
+                                                           deflection along the shaft; ElastoDyn's BldFl1Sh)
 
 plus the rotor azimuth relative to the nacelle, whose rate is the rotor speed (a cyclic coordinate: no
 stiffness). Tower deflection shapes are ElastoDyn's polynomials (normalised to 1 at the tower top), which
@@ -324,6 +326,12 @@ def build_structure(n_tower_strips: int = 80, n_fe_elements: int = 40) -> Struct
             s_top = _slope_jacobian(shapes, np.array([z1]))[0]
             integral += (h - z1) * s_top.T @ s_top
         k_pd -= b.mass * GRAVITY * integral
+    # the blades' weight, moved along the shaft by their flap deflection, drops as the tower top tilts:
+    # V = -n_b int(m phi) g shaft_x theta_top q_flap
+    coupling = -d.n_blades * flap.first_moment * GRAVITY * shaft[0] * r_top[1]
+    coupling[_FLAP] = 0.0
+    k_pd[:, _FLAP] += coupling
+    k_pd[_FLAP, :] += coupling
 
     # --- static generalised load of the weights (lateral offsets of the RNA CM)
     gravity_load = np.zeros(N_DOF)
