@@ -20,6 +20,7 @@ from importlib import resources
 from pathlib import Path
 
 import numpy as np
+from scipy.integrate import cumulative_trapezoid
 
 __all__ = ["OC3Data", "BladeFlapMode", "load_oc3", "GRAVITY", "RHO_WATER", "RHO_AIR", "WATER_DEPTH"]
 
@@ -94,8 +95,7 @@ def _blade_flap_mode(bl: dict[str, str], blade: np.ndarray, hub_r: float, tip: f
     phi = (coeffs[None, :] * x[:, None] ** powers).sum(axis=1)
     d1 = (coeffs * powers * x[:, None] ** (powers - 1)).sum(axis=1) / length
     d2 = (coeffs * powers * (powers - 1) * x[:, None] ** (powers - 2)).sum(axis=1) / length**2
-    tension = np.trapezoid(m * r, r) - np.concatenate([[0.0], np.cumsum(0.5 * (m[1:] * r[1:] + m[:-1] * r[:-1])
-                                                                         * np.diff(r))])
+    tension = np.trapezoid(m * r, r) - cumulative_trapezoid(m * r, r, initial=0.0)  # N(r) = int_r^R m s ds
     return BladeFlapMode(
         mass=float(np.trapezoid(m * phi**2, r)),
         stiffness=float(np.trapezoid(ei * d2**2, r)),

@@ -732,7 +732,7 @@ def replay_forcing(sim: Simulator, n_steps: int, t_start: float, waves: Measured
                                          / b.shape[1], N_BLADE_AZIMUTH)
             blade = np.empty((n, N_BLADE_AZIMUTH), dtype=np.float32)
             # each azimuth of the tilted disc meets the field with its own delay (Simulator.blade_sampling_delay)
-            delay = sim.blade_sampling_delay(lc.wind_speed if lc.wind_speed > 0 else wind.mean_speed())
+            delay = sim.blade_sampling_delay()  # at the load case's wind speed (> 0: checked above)
             for j in range(N_BLADE_AZIMUTH):
                 blade[:, j] = np.interp(tw - delay[j], wind.t, b[:, j])
         else:

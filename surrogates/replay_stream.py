@@ -366,6 +366,8 @@ class ReplayForcing:
                 raise ValueError(f"wind: the mean hub wind must be > 0 m/s, got {self.wind_mean:g}")
         # Taylor advection from the wind's plane to the rotor (as surrogates.replay.replay_forcing)
         self.wind_delay = advection_delay(sim, x_ref=wind.x_ref)
+        # and from the rotor centre to each azimuth of the tilted disc (Simulator.blade_sampling_delay)
+        self.blade_delay = sim.blade_sampling_delay()
         geo = SparGeometry()
         z, _, _ = geo.strips(sim.strip_z.size)
         self._transfer_z = z
@@ -465,9 +467,8 @@ class ReplayForcing:
                 blade = blade_effective_wind(blade[:, None, :], np.array([1.0]),
                                              np.arange(blade.shape[1]) * 2 * np.pi / blade.shape[1], N_BLADE_AZIMUTH)
             b = np.empty((t.size, N_BLADE_AZIMUTH), dtype=np.float32)
-            delay = self.sim.blade_sampling_delay(self.sim.case.wind_speed)  # the tilted disc: see Simulator
             for j in range(N_BLADE_AZIMUTH):
-                b[:, j] = np.interp(t - delay[j], t_rows, blade[:, j])
+                b[:, j] = np.interp(t - self.blade_delay[j], t_rows, blade[:, j])
             inter.append(b)
         else:
             inter.append(None)
@@ -496,8 +497,7 @@ class ReplayForcing:
         wv, wd = self.waves, self.wind
         ra = self._rows(wv.series, float(t[0]), float(t[-1]), wv.margin_s)
         # pointwise levels need no margin, but the blade winds are read up to the tilted disc's sampling delays
-        margin_wind = (wd.margin_s if wd.level == "hub"
-                       else float(np.max(np.abs(sim.blade_sampling_delay()))) + wd.series.dt)
+        margin_wind = wd.margin_s if wd.level == "hub" else float(np.max(np.abs(self.blade_delay))) + wd.series.dt
         tw = t - self.wind_delay  # the wind the rotor meets now passed the measurement plane at tw
         rb = self._rows(wd.series, float(tw[0]), float(tw[-1]), margin_wind)
         if wv.series is wd.series:
