@@ -181,8 +181,9 @@ _BAR: type | None = None
 # The clock of a bar on a terminal is kept by a small helper process: a thread of this process cannot redraw
 # while a C extension holds the GIL (one scipy.linalg.eigh or svd call held it 36-66 s on the busy 2-core
 # machine, freezing the bar's elapsed time and ETA; numpy.linalg releases it). The helper hears the bar's state
-# at every draw, postfix change and (at most every 0.1 s) update, and redraws it with the time gone by whenever it
-# has heard nothing for a tick; it stops when told or when this process ends (its stdin closes).
+# at every draw, postfix change and (at most every 0.1 s) update, draws the bar's own frames (the only writer of
+# them, so that a redraw cannot land after a newer frame), and redraws it with the time gone by whenever it has
+# heard nothing for a tick; it stops when told or when this process ends (its stdin closes).
 _CLOCK_SOURCE = r"""
 import json, os, select, signal, sys, time
 signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -200,6 +201,14 @@ while not done:
                 done = True
             elif line.strip():
                 state, heard = json.loads(line), time.monotonic()
+                if state.pop("draw", False) and not done:  # the bar's own frame: this process is its only writer
+                    d = dict(state)
+                    d.pop("delay", None)
+                    if fmt is None:
+                        from tqdm import tqdm
+                        fmt = tqdm.format_meter
+                    out.write("\r" + fmt(**d))
+                    out.flush()
         done = done or not data
         continue
     if state is None or time.monotonic() - heard < tick:
@@ -254,8 +263,9 @@ def _bar_class() -> type:
             else:
                 threading.Thread(target=self._tick, args=(float(tick_s),), daemon=True).start()
 
-        def _tell(self, force: bool = False) -> None:
-            """Send the bar's state to the clock process (every call when forced, else at most every 0.1 s)."""
+        def _tell(self, force: bool = False, draw: bool = False) -> None:
+            """Send the bar's state to the clock process (every call when forced, else at most every 0.1 s); with
+            ``draw`` the clock draws it at once."""
             clock = getattr(self, "_clock", None)
             if clock is None or clock.stdin is None:
                 return
@@ -265,14 +275,20 @@ def _bar_class() -> type:
             self._sent = now
             state = dict(self.format_dict)
             state["delay"] = float(self.delay or 0.0)
+            state["draw"] = draw
             try:
                 clock.stdin.write((json.dumps(state, default=str) + "\n").encode())
                 clock.stdin.flush()
             except (OSError, ValueError):  # the clock is gone: the bar still works, without it
                 self._clock = None
 
-        def display(self, *args: Any, **kwargs: Any) -> Any:
-            out = super().display(*args, **kwargs)
+        def display(self, msg: str | None = None, pos: int | None = None) -> Any:
+            if getattr(self, "_clock", None) is not None and msg is None and not pos:
+                # the clock process draws every frame, so that its redraws and this one cannot cross on the
+                # terminal (a stale count drawn after a newer one: 0, 5, 0, 600 under load)
+                self._tell(force=True, draw=True)
+                return True
+            out = super().display(msg=msg, pos=pos)
             self._tell(force=True)
             return out
 
