@@ -12,12 +12,16 @@ Analysis tool (not imported by the package). It holds
   precision, the run's own AeroDyn file with only UA_Mod / TwrPotent / Skew_Mod / outputs changed), recorded in
   AERODYN_DRIVER below; ``write_driver`` regenerates the driver inputs.
 
-Run:  python tools/rotor_gap_py      (about 3 minutes on one core)
+Run:  python tools/rotor_gap_bem.py     (about 3 minutes on one core)
 """
-import math, re, time, warnings
-import numpy as np
+import math
+import re
+import warnings
 from pathlib import Path
+
+import numpy as np
 from scipy.signal import butter, sosfiltfilt
+
 from fowt_env.io import read_openfast
 
 warnings.filterwarnings('ignore')
@@ -115,7 +119,8 @@ def solve_bem(Vx, Vy, r, rtip, chord, theta, afid, aidrag=False, tidrag=False, t
         g2 = np.maximum(2 * F * k - F * (4 / 3 - F), 0)
         g3 = 2 * F * k - (25 / 9 - 2 * F)
         small = np.abs(g3) < 1e-6
-        a_buhl = np.where(small, 1 - 1 / (2 * np.sqrt(np.maximum(g2, 1e-12))), (g1 - np.sqrt(g2)) / np.where(small, 1, g3))
+        a_buhl = np.where(small, 1 - 1 / (2 * np.sqrt(np.maximum(g2, 1e-12))),
+                          (g1 - np.sqrt(g2)) / np.where(small, 1, g3))
         a = np.where(hi, a_buhl, a)
         ap = kp / (1 - kp) if tanind else np.zeros_like(kp)
         res = sphi / (1 - a) - Vx / Vy * cphi / (1 + ap)
@@ -177,8 +182,6 @@ def rotor(V, omega, pitch_deg, tilt_deg=5.0, precone_deg=2.5, shear=0.2, hub_ht=
     up = np.array([math.sin(tau), 0.0, math.cos(tau)])
     ey = np.array([0.0, 1.0, 0.0])
     psis = np.arange(n_az) * 2 * np.pi / n_az
-    T = 0.0
-    Q = 0.0
     theta = TWIST + math.radians(pitch_deg)
     # build arrays (n_az, n_node)
     P = psis[:, None]
@@ -206,7 +209,6 @@ def rotor(V, omega, pitch_deg, tilt_deg=5.0, precone_deg=2.5, shear=0.2, hub_ht=
     Vx = np.sum(wind * n, axis=-1)
     Vy = omega * rad[None, :] - np.sum(wind * t, axis=-1)
     rr = np.broadcast_to(rad[None, :], Vx.shape)
-    inner = slice(0, len(s))
     # evaluate interior nodes (tip node: zero load)
     phi, a, ap = solve_bem(Vx, Vy, rr, rtip, np.broadcast_to(CHORD, Vx.shape), np.broadcast_to(theta, Vx.shape),
                            np.broadcast_to(AFID, Vx.shape), aidrag=aidrag, tidrag=tidrag)
@@ -309,18 +311,21 @@ def rotor_series(u_fun, omega, pitch_deg, tilt_deg, tip_defl, v_hub, hub_ht=90.0
         T[k] = B * np.trapezoid(fn * np.cos(kap[k])[None, :], SPAN, axis=1).mean()
         Q[k] = B * np.trapezoid(ft * rad[k][None, :], SPAN, axis=1).mean()
     return T, Q
-import time
-from scipy.signal import butter, sosfiltfilt
-from fowt_env.io import read_openfast
-warnings.filterwarnings('ignore')
+
+
 Bd = '/work/shared/reference/openfast/runs/'
-mr = 109389.852; g = 9.80665
+mr = 109389.852
+g = 9.80665
+
 
 def load(case, step=40):
     r = read_openfast(f'{Bd}{case}/{case}.outb')
     t = np.asarray(r.t, float)
-    x = {c: np.asarray(r[c], float) for c in ['RotSpeed','BldPitch1','PtfmPitch','TTDspFA','PtfmSurge','RotThrust','LSShftTq','OoPDefl1','TwHt9ALxt','Wind1VelX','PtfmHeave']}
-    pit = np.deg2rad(x['PtfmPitch']); ttop = pit + 1.5 * x['TTDspFA'] / 77.6
+    x = {c: np.asarray(r[c], float) for c in ['RotSpeed', 'BldPitch1', 'PtfmPitch', 'TTDspFA', 'PtfmSurge',
+                                              'RotThrust', 'LSShftTq', 'OoPDefl1', 'TwHt9ALxt', 'Wind1VelX',
+                                              'PtfmHeave']}
+    pit = np.deg2rad(x['PtfmPitch'])
+    ttop = pit + 1.5 * x['TTDspFA'] / 77.6
     Taero = x['RotThrust'] * 1e3 - mr * g * np.sin(math.radians(5) + ttop) + mr * x['TwHt9ALxt']
     dt = t[1] - t[0]
     sos = butter(4, 0.5, fs=1/dt, output='sos')
@@ -328,24 +333,31 @@ def load(case, step=40):
     vhub = np.gradient(xh, dt)
     zhub = 87.6 * np.cos(pit) + 1.96 * np.cos(pit) + 5.02 * np.sin(pit) + x['PtfmHeave']
     idx = np.arange(0, len(t), step)
-    return dict(t=t[idx], omega=x['RotSpeed'][idx] * math.pi / 30, pitch=x['BldPitch1'][idx], tilt=5 + np.degrees(ttop[idx]),
-                defl=x['OoPDefl1'][idx], vhub=vhub[idx], zhub=zhub[idx], Taero=Taero, Q=x['LSShftTq'] * 1e3, V=x['Wind1VelX'][idx],
-                Taero_s=Taero[idx], Q_s=x['LSShftTq'][idx]*1e3)
+    return dict(t=t[idx], omega=x['RotSpeed'][idx] * math.pi / 30, pitch=x['BldPitch1'][idx],
+                tilt=5 + np.degrees(ttop[idx]), defl=x['OoPDefl1'][idx], vhub=vhub[idx], zhub=zhub[idx], Taero=Taero,
+                Q=x['LSShftTq'] * 1e3, V=x['Wind1VelX'][idx], Taero_s=Taero[idx], Q_s=x['LSShftTq'][idx]*1e3)
+
 
 def field(case):
     f = np.load(f'{Bd}{case}/{case}.inflow.npz')
     return f['t'], f['polar_u'].astype(float), f['polar_radii'], f['polar_azimuth_rad'], f['disc_mean_u'].astype(float)
 
+
 def make_ufun(case, times, scale=1.0):
     tf, pu, rr, az, dm = field(case)
     idx = np.clip(np.searchsorted(tf, times), 0, len(tf) - 1)
-    naz = len(az); daz = az[1] - az[0]
+    naz = len(az)
+    daz = az[1] - az[0]
+
     def u(k, r, psi):
         fld = pu[idx[k]]
         fr = np.clip(r / rr[-1] * (len(rr) - 1), 0, len(rr) - 1.000001)
-        i = fr.astype(int); wr = fr - i
+        i = fr.astype(int)
+        wr = fr - i
         fa = (psi % (2 * np.pi)) / daz
-        j = fa.astype(int) % naz; wa = fa - np.floor(fa); j1 = (j + 1) % naz
+        j = fa.astype(int) % naz
+        wa = fa - np.floor(fa)
+        j1 = (j + 1) % naz
         v = (1 - wr) * ((1 - wa) * fld[i, j] + wa * fld[i, j1]) + wr * ((1 - wa) * fld[i + 1, j] + wa * fld[i + 1, j1])
         # extrapolate beyond 60 m with the outermost ring
         return v * scale
@@ -367,7 +379,8 @@ AERODYN_DRIVER = {
     'T08_bare': (391.6, 2037.8), 'T08_noUA': (391.6, 2033.4), 'T08_deck': (374.6, 1930.3),
     'O08_bare': (387.9, 1998.3), 'O08_noUA': (388.1, 1992.4), 'O08_deck': (371.1, 1889.7),
     'O08_noUA_d': (387.8, 1972.1), 'O08_deck_d': (370.8, 1867.9),
-    'AX12_noUA': (727.2, 4770.6), 'AX12_deck': (701.0, 4586.7), 'AX08_noUA': (398.9, 2098.2), 'AX08_deck': (381.0, 1984.8),
+    'AX12_noUA': (727.2, 4770.6), 'AX12_deck': (701.0, 4586.7),
+    'AX08_noUA': (398.9, 2098.2), 'AX08_deck': (381.0, 1984.8),
 }
 # AX12, sectional Cl with UA_Mod=3 / static polar in perfectly steady axisymmetric inflow (nodes 6-12):
 # DU35 -2.0/-6.9 %, DU30 -0.8 %, DU25 -11.6/-12.7 %, DU21 -8.9/-8.8 %, NACA64 0 % (Cd 0.0065 vs 0.0057: its UA Cd0).
@@ -407,7 +420,8 @@ UA_RATIO_TORQUE = np.array([
 
 def write_driver(out_dir, name, ad_file, hub_ht, tilt_deg, cases, precone_deg=2.5):
     """Write an AeroDyn driver file (basic HAWT, combined cases: (V, PLExp, rpm, pitch_deg, tmax))."""
-    rows = '\n'.join(f'{v:.4f}  {pl:.3f}  {rpm:.4f}  {p:.4f}  0.  0.0125  {tm:.1f}  0  0  0' for v, pl, rpm, p, tm in cases)
+    rows = '\n'.join(f'{v:.4f}  {pl:.3f}  {rpm:.4f}  {p:.4f}  0.  0.0125  {tm:.1f}  0  0  0'
+                     for v, pl, rpm, p, tm in cases)
     txt = f'''----- AeroDyn Driver Input File ---------------------------------------------------------
 rotor-gap study
 ----- Input Configuration ---------------------------------------------------------------
@@ -491,7 +505,10 @@ def openfast_point(case):
     """Mean OpenFAST operating point and rotor loads (aerodynamic thrust: RotThrust minus the rotor weight along the
     shaft, elevation 5 deg + PtfmPitch + 1.5 TTDspFA / 77.6 m)."""
     r = read_openfast(f'{Bd}{case}/{case}.outb')
-    m = lambda c: float(np.mean(np.asarray(r[c], float)))
+
+    def m(c):
+        return float(np.mean(np.asarray(r[c], float)))
+
     pit = math.radians(m('PtfmPitch'))
     elev = math.radians(5.0) + pit + 1.5 * m('TTDspFA') / 77.6
     return dict(V=m('Wind1VelX'), omega=m('RotSpeed') * math.pi / 30, pitch=m('BldPitch1'), elev_deg=math.degrees(elev),
@@ -499,7 +516,7 @@ def openfast_point(case):
 
 
 def main():
-    from surrogates.aero import rotor_table, rotor_coefficients
+    from surrogates.aero import rotor_coefficients, rotor_table
     tab = rotor_table()
     q12 = 0.5 * RHO * np.pi * 63.0 ** 2 * 12.0 ** 2
     op = openfast_point('d_steady12_Hs2p5_Tp10')
@@ -508,7 +525,8 @@ def main():
     Ttab, Qtab = q12 * ct, q12 * 63 * cq
     print(f"12 m/s steady: TSR {lam:.3f}, pitch {op['pitch']:.3f} deg, shaft elevation {op['elev_deg']:.2f} deg, "
           f"OoPDefl1 {op['defl']:.2f} m")
-    print(f"  OpenFAST  T {op['T']/1e3:.1f} kN  Q {op['Q']/1e3:.1f} kNm;  table (hub wind)  T {Ttab/1e3:.1f}  Q {Qtab/1e3:.1f}"
+    print(f"  OpenFAST  T {op['T']/1e3:.1f} kN  Q {op['Q']/1e3:.1f} kNm;  "
+          f"table (hub wind)  T {Ttab/1e3:.1f}  Q {Qtab/1e3:.1f}"
           f"  -> gap T {op['T']/Ttab-1:+.2%} Q {op['Q']/Qtab-1:+.2%}")
     A = AERODYN_DRIVER
     steps = [
@@ -520,12 +538,14 @@ def main():
     tot_t = tot_q = 1.0
     for name, a, b in steps:
         rt, rq = a[0] / b[0], a[1] / b[1]
-        tot_t *= rt; tot_q *= rq
+        tot_t *= rt
+        tot_q *= rq
         print(f'  {name:58s} T {rt-1:+.2%}  Q {rq-1:+.2%}')
     # platform motion and pitch/speed fluctuations: quasi-steady BEM, time series vs its own steady mean point
     d = load('d_steady12_Hs2p5_Tp10', step=80)
     n = len(d['t'])
-    Ts = np.empty(n); Qs = np.empty(n)
+    Ts = np.empty(n)
+    Qs = np.empty(n)
     for k in range(n):
         a, b = rotor_series(None, d['omega'][k:k+1], d['pitch'][k:k+1], d['tilt'][k:k+1], d['defl'][k:k+1],
                             d['vhub'][k:k+1], hub_ht=d['zhub'][k], shear=0.2, V=d['V'][k:k+1])
@@ -533,7 +553,8 @@ def main():
     T0, Q0, _ = rotor(12.0, op['omega'], op['pitch'], tilt_deg=op['elev_deg'], hub_ht=float(d['zhub'].mean()),
                       tip_defl=op['defl'])
     rt, rq = Ts.mean() / T0, Qs.mean() / Q0
-    tot_t *= rt; tot_q *= rq
+    tot_t *= rt
+    tot_q *= rq
     print(f"  {'platform motion + pitch/speed fluctuations (BEM series)':58s} T {rt-1:+.2%}  Q {rq-1:+.2%}")
     print(f"  {'product (predicted gap)':58s} T {tot_t-1:+.2%}  Q {tot_q-1:+.2%};  residual OF/predicted "
           f"T {op['T']/(Ttab*tot_t)-1:+.2%} Q {op['Q']/(Qtab*tot_q)-1:+.2%}")
@@ -543,7 +564,8 @@ def main():
     u, _ = make_ufun(case, d['t'])
     T, Q = rotor_series(u, d['omega'], d['pitch'], d['tilt'], d['defl'], d['vhub'])
     ua_t, ua_q = A['O08_deck_d'][0] / A['O08_noUA_d'][0], A['O08_deck_d'][1] / A['O08_noUA_d'][1]
-    print(f"8 m/s turbulent (2 Hz samples): OpenFAST T {d['Taero_s'].mean()/1e3:.1f} kN Q {d['Q_s'].mean()/1e3:.1f} kNm;"
+    print(f"8 m/s turbulent (2 Hz samples): OpenFAST T {d['Taero_s'].mean()/1e3:.1f} kN "
+          f"Q {d['Q_s'].mean()/1e3:.1f} kNm;"
           f" BEM (static polars, deflected, OF elevation) T {T.mean()/1e3:.1f} Q {Q.mean()/1e3:.1f} -> OF/BEM "
           f"T {d['Taero_s'].mean()/T.mean()-1:+.2%} Q {d['Q_s'].mean()/Q.mean()-1:+.2%}; UA factor (AeroDyn) "
           f"T {ua_t-1:+.2%} Q {ua_q-1:+.2%} -> residual T {d['Taero_s'].mean()/(T.mean()*ua_t)-1:+.2%} "
