@@ -29,7 +29,7 @@ from threadpoolctl import threadpool_limits
 
 import surrogates
 from surrogates.drag import N_STRIPS
-from surrogates.simulate import FIELD_DT, N_BLADE_AZIMUTH, Simulator
+from surrogates.simulate import FIELD_AZIMUTH, FIELD_DT, FIELD_GRID_SPACING, Simulator
 from surrogates.waves import synthesize_waves
 from surrogates.wind import synthesize_rotor_wind
 
@@ -82,7 +82,8 @@ def main() -> None:
                                                            sim.dt_int, seed=1, n_strips=N_STRIPS), args.repeats)[1]
         cpu_wind = best_wall_cpu(lambda: synthesize_rotor_wind(case.wind_speed, case.turbulence_intensity,
                                                                span + 2 * FIELD_DT, FIELD_DT, seed=1,
-                                                               n_azimuth=N_BLADE_AZIMUTH), args.repeats)[1]
+                                                               n_azimuth=FIELD_AZIMUTH,
+                                                               grid_spacing=FIELD_GRID_SPACING), args.repeats)[1]
     cpu_step = cpu_full - cpu_setup - cpu_forcing
     print(f"  full nonlinear model, 1 core : {args.duration / t_full:8.0f}x real time ({t_full:.3f} s wall; "
           f"{args.duration / cpu_full:.0f}x per second of this process's CPU time, {cpu_full:.3f} s)")

@@ -514,9 +514,13 @@ def _given_wind(wind: MeasuredWind) -> StreamedWind:
         shear = slice(2, 4)
         cols += [wind.shear_y, wind.shear_z]
     data = np.column_stack(cols)
+    inplane = None
     if wind.blade is not None:
         blade = slice(data.shape[1], data.shape[1] + wind.blade.shape[1])
         data = np.hstack([data, np.asarray(wind.blade, float)])
+        if wind.blade_inplane is not None:
+            inplane = slice(data.shape[1], data.shape[1] + wind.blade_inplane.shape[1])
+            data = np.hstack([data, np.asarray(wind.blade_inplane, float)])
     dt = float(np.median(np.diff(wind.t)))
     return StreamedWind(ArraySeries(float(wind.t[0]), dt, data), "given", hub_column=0, effective_column=1,
-                        shear_columns=shear, field_columns=blade, x_ref=wind.x_ref)
+                        shear_columns=shear, field_columns=blade, inplane_columns=inplane, x_ref=wind.x_ref)

@@ -28,7 +28,8 @@ from scipy.optimize import brentq
 
 from .oc3 import RHO_AIR
 
-__all__ = ["RotorTable", "rotor_table", "OperatingPoint", "operating_point", "RATED"]
+__all__ = ["RotorTable", "rotor_table", "OperatingPoint", "operating_point", "RATED", "blade_inplane_sensitivity",
+           "inplane_ring_weights"]
 
 RATED = {
     "electrical_power": 5.0e6,  # W (Jonkman et al. 2009, Table 1-1)
@@ -258,3 +259,99 @@ def operating_point(
         aero_torque=float(torque), generator_torque_lss=float(torque), kp=float(kp), ki=float(ki),
         dQgen_dOmega=float(dqgen), above_rated=bool(above), **{k: float(v) for k, v in sens.items()},
     )
+
+
+@lru_cache(maxsize=1)
+def _inplane_table() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    import json
+
+    data = json.loads(resources.files("surrogates").joinpath("data/blade_inplane_sensitivity.json").read_text())
+    width = np.asarray(data["width"], dtype=float)
+    per_node = np.asarray(data["dFt_dU"], dtype=float) * width[None, :]
+    return np.asarray(data["radius"], dtype=float), np.asarray(data["wind_speed"], dtype=float), per_node
+
+
+def blade_inplane_sensitivity(wind_speed: float) -> tuple[np.ndarray, np.ndarray]:
+    """How one blade's in-plane aerodynamic force answers the streamwise wind along its span.
+
+    At the steady operating point of ``wind_speed`` the tangential force (in the rotor plane, along the
+    rotation) of each AeroDyn node of the NREL 5 MW blade changes by ``s_i`` per m/s of axial wind at that
+    node: a quasi-steady blade-element momentum model of the OC3 deck's AeroDyn blade and polars
+    (``tools/blade_inplane_sensitivity.py``, tabulated at 3-25 m/s in ``surrogates/data``; linear in the
+    wind speed between, held outside). The sum, one blade's in-plane force per m/s of uniform wind, is 6.6,
+    9.2 and 11.9 kN/(m/s) at 8, 12 and 18 m/s, weighted towards mid-span (unlike the torque, whose lever puts
+    its weight outboard). A turbulent field that differs from blade to blade leaves these forces unbalanced:
+    the rotor's in-plane side and vertical force, the side-to-side excitation of the tower.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Mean wind speed (m/s), > 0.
+
+    Returns
+    -------
+    radius : ndarray (n_nodes,)
+        Node radii from the rotor centre (m).
+    force_per_wind : ndarray (n_nodes,)
+        Change of each node's in-plane force (N per m/s of wind at the node), span width included.
+
+    Examples
+    --------
+    >>> r, s = blade_inplane_sensitivity(12.0)
+    >>> round(float(s.sum()) / 1e3, 1), bool(20.0 < float(r[np.argmax(s)]) < 50.0)
+    (9.2, True)
+    """
+    if not np.isfinite(wind_speed) or wind_speed <= 0:
+        raise ValueError(f"wind_speed must be a positive finite number (m/s), got {wind_speed!r}")
+    radius, speeds, per_node = _inplane_table()
+    v = float(np.clip(wind_speed, speeds[0], speeds[-1]))
+    j = int(np.clip(np.searchsorted(speeds, v) - 1, 0, speeds.size - 2))
+    frac = (v - speeds[j]) / (speeds[j + 1] - speeds[j])
+    return radius.copy(), (1.0 - frac) * per_node[j] + frac * per_node[j + 1]
+
+
+def inplane_ring_weights(ring_radii: np.ndarray, wind_speed: float) -> tuple[np.ndarray, float]:
+    """Weights of a polar field's rings for one blade's in-plane force, and its gain.
+
+    The nodes' sensitivities of :func:`blade_inplane_sensitivity` are shared between the two rings around
+    each node in proportion to its distance from them (linear interpolation of the wind between rings, as the
+    field is read); nodes beyond the outermost ring load it. Then a blade's in-plane force changes by
+    ``gain * sum_k weights_k (u_k - U)`` for ring winds ``u_k`` along it.
+
+    Parameters
+    ----------
+    ring_radii : array_like (n_rings,)
+        Ring radii (m), increasing, >= 0.
+    wind_speed : float
+        Mean wind speed (m/s), > 0.
+
+    Returns
+    -------
+    weights : ndarray (n_rings,)
+        Non-negative, summing to 1.
+    gain : float
+        One blade's in-plane force per m/s of uniform wind change (N·s/m).
+
+    Examples
+    --------
+    >>> w, g = inplane_ring_weights([0.0, 15.75, 31.5, 47.25, 63.0], 12.0)
+    >>> round(float(w.sum()), 12), int(np.argmax(w)), round(g / 1e3, 1)
+    (1.0, 2, 9.2)
+    """
+    rings = np.asarray(ring_radii, dtype=float)
+    if rings.ndim != 1 or rings.size < 1 or not np.all(np.isfinite(rings)) or np.any(np.diff(rings) <= 0):
+        raise ValueError(f"ring_radii must be finite and increasing (m), got {ring_radii!r}")
+    radius, sens = blade_inplane_sensitivity(wind_speed)
+    weights = np.zeros(rings.size)
+    for r, s in zip(radius, sens, strict=True):
+        if rings.size == 1 or r >= rings[-1]:
+            weights[-1] += s
+        elif r <= rings[0]:
+            weights[0] += s
+        else:
+            k = int(np.searchsorted(rings, r) - 1)
+            frac = (r - rings[k]) / (rings[k + 1] - rings[k])
+            weights[k] += (1.0 - frac) * s
+            weights[k + 1] += frac * s
+    gain = float(sens.sum())
+    return weights / gain, gain

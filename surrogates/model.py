@@ -705,15 +705,13 @@ class FOWTModel:
         return [UNITS[c] for c in channels]
 
 
-ROTOR_ASYMMETRY = {"moment": 0.17, "yaw_moment": 0.23, "side_force": 0.45}
+ROTOR_ASYMMETRY = {"moment": 0.17, "yaw_moment": 0.23}
 """Gains of the rotor's response to a linear wind gradient over the disc (-): tilt moment
 ``= moment * dT/dU * R^2 * dU/dz``, yaw moment ``= -yaw_moment * dT/dU * R^2 * dU/dy`` (blade-element scaling: the
-local thrust slope times the lever squared), side force ``= -side_force * dQ/dU * dU/dz`` (the in-plane forces of
-the upper and lower blades no longer cancel). Calibrated against OpenFAST's OC3 Hywind runs at 8, 12 and 18 m/s:
+local thrust slope times the lever squared). Calibrated against OpenFAST's OC3 Hywind runs at 8, 12 and 18 m/s:
 
-* ``moment`` and ``side_force``: tower-top tilt moment and rotor side force regressed on the disc-fit gradients of
-  the TurbSim inflow (the tilt gain the same within 10 % at the three speeds; the side force within 15 % at 8 and
-  12 m/s, 30 % low at 18); the tilt gain also gives OpenFAST's mean tower-base moment under the mean shear;
+* ``moment``: tower-top tilt moment regressed on the disc-fit gradients of the TurbSim inflow (the same within
+  10 % at the three speeds); it also gives OpenFAST's mean tower-base moment under the mean shear;
 * ``yaw_moment``: from the platform yaw below its 0.12 Hz mode, where the yaw is quasi-static (moment over the
   deck's yaw stiffness), replaying each run's own inflow field (``fowt-env validate --replay``): with 0.17 the
   yaw std below 0.05 Hz was 0.73/0.71/0.77 of OpenFAST's at 8/12/18 m/s, i.e. 0.233/0.239/0.221; 0.23 gives
@@ -723,7 +721,12 @@ the upper and lower blades no longer cancel). Calibrated against OpenFAST's OC3 
   vertical plane).
 
 The yaw and tilt rates of the disc are loaded through the same gains (the rotor's aerodynamic yaw and tilt
-damping, ``aero_damping``)."""
+damping, ``aero_damping``). The rotor's in-plane (side and vertical) force is not calibrated: each blade's in-plane
+force answers the wind along it as the deck's blade does (:func:`surrogates.aero.blade_inplane_sensitivity`, a
+blade-element model of its AeroDyn blade; the side force under a gradient ``dU/dz`` is ``-1.5 G r_ip dU/dz`` with
+``G`` one blade's gain and ``r_ip`` its mean radius, :func:`inplane_gradient_gain`). It replaced a gain regressed
+on the disc-fit gradient (``side_force = 0.45`` of ``dQ/dU``), which gave 0.62-0.74 of OpenFAST's aerodynamic
+side force in the 1st tower band, fed with OpenFAST's own winds (0.84-0.97 now)."""
 
 TOWER_AERO = {"cd": 1.0, "diameter_base": 6.5, "diameter_top": 3.87, "shear_exponent": 0.2, "hub_height": 90.0}
 """Tower aerodynamic drag of the OC3 deck (AeroDyn ``TwrAero = True``: Cd = 1.0, diameter 6.5 m at the base to
@@ -736,17 +739,29 @@ BLADE_SAMPLING_RADIUS = 0.75
 proportional to the radius over the rings at R/4, R/2, 3R/4 and R."""
 
 
-def blade_load_radii(radius: float) -> tuple[float, float, float]:
-    """Effective radii (m) of a blade's thrust for the tilt moment, of its in-plane force (torque / r) and of
-    its thrust for the yaw moment in the rotationally sampled rotor model, chosen so that under a linear wind
-    gradient it gives exactly the calibrated gradient model of :data:`ROTOR_ASYMMETRY` (tilt ``= moment dT/dU
-    R^2 dU/dz``: ``r_s r_T / 2 = moment R^2``; side force ``= -side_force dQ/dU dU/dz``: ``r_s / (2 r_Q) =
-    side_force``; yaw likewise with ``yaw_moment``)."""
+def blade_load_radii(radius: float) -> tuple[float, float]:
+    """Effective radii (m) of a blade's thrust for the tilt moment and for the yaw moment in the rotationally
+    sampled rotor model, chosen so that under a linear wind gradient it gives exactly the calibrated gradient
+    model of :data:`ROTOR_ASYMMETRY` (tilt ``= moment dT/dU R^2 dU/dz``: ``r_s r_T / 2 = moment R^2``; yaw likewise
+    with ``yaw_moment``)."""
     r_s = BLADE_SAMPLING_RADIUS * radius
     r_t = 2.0 * ROTOR_ASYMMETRY["moment"] * radius**2 / r_s
-    r_q = r_s / (2.0 * ROTOR_ASYMMETRY["side_force"])
     r_ty = 2.0 * ROTOR_ASYMMETRY["yaw_moment"] * radius**2 / r_s
-    return r_t, r_q, r_ty
+    return r_t, r_ty
+
+
+def inplane_gradient_gain(wind_speed: float) -> float:
+    """The rotor's in-plane force per unit linear wind gradient over the disc (N·s): ``1.5 G r_ip``.
+
+    A gradient ``g`` along the blades' plane loads each blade's in-plane force by ``G g r_ip cos(psi_b)``
+    (:func:`surrogates.aero.blade_inplane_sensitivity`: ``G`` the sum of the nodes' gains, ``r_ip`` their
+    gain-weighted mean radius); summed over three blades, projected on the side (vertical) direction, that is
+    ``1.5 G r_ip g``: 0.52, 0.52 and 0.51 of ``dQ/dU`` at 8, 12 and 18 m/s (the regression it replaced: 0.45).
+    """
+    from .aero import blade_inplane_sensitivity
+
+    r, s = blade_inplane_sensitivity(wind_speed)
+    return float(1.5 * np.sum(s * r))
 
 
 def _shear_hub_loads(op: OperatingPoint | None, radius: float, strength: float):
@@ -756,8 +771,8 @@ def _shear_hub_loads(op: OperatingPoint | None, radius: float, strength: float):
         return [zero, zero]
     k_m = strength * ROTOR_ASYMMETRY["moment"] * op.dT_dV * radius**2
     k_my = strength * ROTOR_ASYMMETRY["yaw_moment"] * op.dT_dV * radius**2
-    k_f = strength * ROTOR_ASYMMETRY["side_force"] * op.dQ_dV
-    per_gy = (np.zeros(3), np.array([0.0, 0.0, -k_my]))
+    k_f = strength * inplane_gradient_gain(op.wind_speed)
+    per_gy = (np.array([0.0, 0.0, k_f]), np.array([0.0, 0.0, -k_my]))
     per_gz = (np.array([0.0, -k_f, 0.0]), np.array([0.0, k_m, 0.0]))
     return [per_gy, per_gz]
 

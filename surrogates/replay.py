@@ -68,6 +68,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy.fft import irfft, next_fast_len, rfft
 
+from .aero import inplane_ring_weights
 from .oc3 import WATER_DEPTH
 from .validation import check_number
 from .waves import SparGeometry, WaveLoads, _loads_from_transfer_series, _wave_transfer_rows
@@ -85,6 +86,7 @@ __all__ = [
     "as_measured_waves",
     "as_measured_wind",
     "blade_effective_wind",
+    "stepper_blade_winds",
     "measured_azimuth",
     "with_measured_azimuth",
     "polar_from_grid",
@@ -315,12 +317,13 @@ def _profile_disc_mean(exponent: float, hub_height: float = 90.0, radius: float 
 
 
 def blade_effective_wind(polar_u: np.ndarray, radii: np.ndarray, azimuth_rad: np.ndarray,
-                         n_azimuth: int = 24) -> np.ndarray:
+                         n_azimuth: int = 24, weights: np.ndarray | None = None) -> np.ndarray:
     """Each blade's effective streamwise wind around the rotor from a polar-grid field (m/s).
 
-    The wind along a blade at azimuth ``psi`` averaged with weights proportional to the radius (what the
-    surrogate's rotationally sampled loads use), at ``n_azimuth`` uniform azimuths from the top towards +y,
-    interpolated periodically from the grid's azimuths.
+    The wind along a blade at azimuth ``psi`` averaged over the rings with weights proportional to the radius
+    (what the surrogate's rotationally sampled thrust and torque use) or with the given ring ``weights``
+    (e.g. :func:`surrogates.aero.inplane_ring_weights` for the in-plane force), at ``n_azimuth`` uniform
+    azimuths from the top towards +y, interpolated periodically from the grid's azimuths.
 
     Parameters
     ----------
@@ -332,6 +335,8 @@ def blade_effective_wind(polar_u: np.ndarray, radii: np.ndarray, azimuth_rad: np
         Uniform azimuths (rad) from the top towards +y.
     n_azimuth : int
         Azimuths of the result.
+    weights : array_like (n_radii,), optional
+        Ring weights (normalised to sum 1); default proportional to the radius.
 
     Returns
     -------
@@ -342,9 +347,14 @@ def blade_effective_wind(polar_u: np.ndarray, radii: np.ndarray, azimuth_rad: np
     psi = np.asarray(azimuth_rad, dtype=float)
     if u.ndim != 3 or u.shape[1:] != (r.size, psi.size):
         raise ValueError(f"polar_u must have shape (n_t, {r.size}, {psi.size}), got {u.shape}")
-    w = np.where(r > 0, r, 0.0)
-    if w.sum() <= 0:
-        raise ValueError("radii must include a ring of radius > 0")
+    if weights is None:
+        w = np.where(r > 0, r, 0.0)
+        if w.sum() <= 0:
+            raise ValueError("radii must include a ring of radius > 0")
+    else:
+        w = np.asarray(weights, dtype=float)
+        if w.shape != r.shape or not np.all(np.isfinite(w)) or np.any(w < 0) or w.sum() <= 0:
+            raise ValueError(f"weights must be {r.size} finite non-negative ring weights, got {weights!r}")
     along = np.einsum("tra,r->ta", u, w / w.sum())
     target = np.arange(n_azimuth) * 2.0 * np.pi / n_azimuth
     ext = np.concatenate([psi, [psi[0] + 2.0 * np.pi]])
@@ -428,6 +438,9 @@ class MeasuredWind:
         turbulence: it reaches the rotor ``(x_rotor - x_ref) / U`` later (:func:`advection_delay`; 2.1 s at
         12 m/s, where the rotor sits ~21 m downwind of x = 0). None: measured at the moving rotor (a rotor
         wind estimate, a spinner anemometer or a lidar referenced to the rotor): no delay.
+    blade_inplane : ndarray (n, n_azimuth) float32 or None
+        The wind along each blade weighted as its in-plane force answers it (m/s,
+        :func:`surrogates.aero.inplane_ring_weights`, same azimuths as ``blade``); None: ``blade`` stands in.
     """
 
     t: np.ndarray
@@ -439,6 +452,7 @@ class MeasuredWind:
     level: str = "rotor_effective"
     source: str = ""
     x_ref: float | None = 0.0
+    blade_inplane: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.x_ref is not None and not np.isfinite(self.x_ref):
@@ -457,6 +471,13 @@ class MeasuredWind:
             if b.ndim != 2 or b.shape[1] < 3:
                 raise ValueError(f"wind: blade must have shape (n, n_azimuth >= 3), got {b.shape}")
             object.__setattr__(self, "blade", b.astype(np.float32))
+        if self.blade_inplane is not None:
+            if self.blade is None:
+                raise ValueError("wind: blade_inplane needs blade (the thrust and torque's blade wind) too")
+            b = _time_series("wind (blade_inplane)", t, self.blade_inplane, columns=True)[1]
+            if b.shape != self.blade.shape:
+                raise ValueError(f"wind: blade_inplane must have the shape of blade {self.blade.shape}, got {b.shape}")
+            object.__setattr__(self, "blade_inplane", b.astype(np.float32))
         if self.level not in ("hub", "rotor_effective", "field"):
             raise ValueError(f"wind: level must be 'hub', 'rotor_effective' or 'field', got {self.level!r}")
         if float(np.mean(eff)) <= 0:
@@ -504,8 +525,11 @@ class MeasuredWind:
                 raise ValueError("wind: give hub= when the polar grid has no ring of radius 0")
             hub = np.asarray(u[:, 0, 0], float)
         blade = blade_effective_wind(u, radii, azimuth_rad, n_azimuth)
-        return cls(np.asarray(t, float), np.asarray(hub, float), mean, gy, gz, blade, level="field",
-                   source=source or "polar wind field", x_ref=x_ref)
+        hub = np.asarray(hub, float)
+        w_ip, _ = inplane_ring_weights(radii, max(float(np.mean(hub)), 0.1))
+        inplane = blade_effective_wind(u, radii, azimuth_rad, n_azimuth, weights=w_ip)
+        return cls(np.asarray(t, float), hub, mean, gy, gz, blade, level="field",
+                   source=source or "polar wind field", x_ref=x_ref, blade_inplane=inplane)
 
     @classmethod
     def from_record(cls, record: Any, channel: str = "Wind1VelX", **kwargs: Any) -> MeasuredWind:
@@ -679,12 +703,27 @@ def with_measured_azimuth(blade: np.ndarray, t: np.ndarray, t_az: np.ndarray, ps
     """The stepper's blade-wind array with the measured azimuth (rad, wrapped) as an extra last column at the
     internal steps' times ``t`` (NaN outside the measurement: the stepper then integrates its own); a forcing
     without a turbulent field gets NaN blade winds (the stepper then computes no rotationally sampled loads)."""
-    from .simulate import N_BLADE_AZIMUTH
+    from .simulate import N_BLADE_COLUMNS
 
     psi = np.interp(t, t_az, psi_az, left=np.nan, right=np.nan) % (2.0 * np.pi)
-    field = blade if blade.shape[0] == t.size else np.full((t.size, N_BLADE_AZIMUTH), np.nan)
-    return np.ascontiguousarray(np.concatenate([field[:, :N_BLADE_AZIMUTH], psi[:, None]], axis=1),
+    field = blade if blade.shape[0] == t.size else np.full((t.size, N_BLADE_COLUMNS), np.nan)
+    return np.ascontiguousarray(np.concatenate([field[:, :N_BLADE_COLUMNS], psi[:, None]], axis=1),
                                 dtype=np.float32)
+
+
+def stepper_blade_winds(blade: np.ndarray, inplane: np.ndarray | None = None) -> np.ndarray:
+    """The stepper's blade winds from measured ones: the thrust and torque's blade wind, then the in-plane
+    force's (``blade`` stands in when ``inplane`` is None), each resampled periodically to
+    ``N_BLADE_AZIMUTH`` uniform azimuths; shape ``(n, N_BLADE_COLUMNS)`` float32 (m/s)."""
+    from .simulate import N_BLADE_AZIMUTH
+
+    def resample(b: np.ndarray) -> np.ndarray:
+        if b.shape[1] == N_BLADE_AZIMUTH:
+            return np.asarray(b, dtype=np.float32)
+        return blade_effective_wind(b[:, None, :], np.array([1.0]), np.arange(b.shape[1]) * 2 * np.pi
+                                    / b.shape[1], N_BLADE_AZIMUTH)
+
+    return np.concatenate([resample(blade), resample(blade if inplane is None else inplane)], axis=1)
 
 
 def replay_forcing(sim: Simulator, n_steps: int, t_start: float, waves: MeasuredWaves | None,
@@ -696,7 +735,7 @@ def replay_forcing(sim: Simulator, n_steps: int, t_start: float, waves: Measured
     given as None keeps its random draw (seeded as in :meth:`Simulator.forcing`).
     """
     from .model import INPUT_BLOCKS
-    from .simulate import N_BLADE_AZIMUTH, N_EX
+    from .simulate import N_BLADE_COLUMNS, N_EX
 
     n = n_steps + 1
     lc = sim.case
@@ -706,7 +745,7 @@ def replay_forcing(sim: Simulator, n_steps: int, t_start: float, waves: Measured
         u_ex = np.zeros((n, N_EX))
         u_ex[:, 0] = 1.0
         vel = np.zeros((n, sim.strip_z.size, 2))
-        blade = np.zeros((0, N_BLADE_AZIMUTH), dtype=np.float32)
+        blade = np.zeros((0, N_BLADE_COLUMNS), dtype=np.float32)
         _, _, psi_ss = seed_sequence.spawn(3)  # the rotor azimuth is drawn as in Simulator.forcing
         psi0 = float(np.random.default_rng(psi_ss).uniform(0.0, 2.0 * np.pi))
     t = t_start + np.arange(n) * sim.dt_int
@@ -726,17 +765,14 @@ def replay_forcing(sim: Simulator, n_steps: int, t_start: float, waves: Measured
         u_ex[:, i_sh] = np.interp(tw, wind.t, wind.shear_y) if wind.shear_y is not None else sim.mean_shear[0]
         u_ex[:, i_sh + 1] = np.interp(tw, wind.t, wind.shear_z) if wind.shear_z is not None else sim.mean_shear[1]
         if wind.blade is not None:
-            b = wind.blade
-            if b.shape[1] != N_BLADE_AZIMUTH:
-                b = blade_effective_wind(b[:, None, :], np.array([1.0]), np.arange(b.shape[1]) * 2 * np.pi
-                                         / b.shape[1], N_BLADE_AZIMUTH)
-            blade = np.empty((n, N_BLADE_AZIMUTH), dtype=np.float32)
+            b = stepper_blade_winds(wind.blade, wind.blade_inplane)
+            blade = np.empty((n, N_BLADE_COLUMNS), dtype=np.float32)
             # each azimuth of the tilted disc meets the field with its own delay (Simulator.blade_sampling_delay)
-            delay = sim.blade_sampling_delay()  # at the load case's wind speed (> 0: checked above)
-            for j in range(N_BLADE_AZIMUTH):
+            delay = np.tile(sim.blade_sampling_delay(), 2)  # at the load case's wind speed (> 0: checked above)
+            for j in range(N_BLADE_COLUMNS):
                 blade[:, j] = np.interp(tw - delay[j], wind.t, b[:, j])
         else:
-            blade = np.zeros((0, N_BLADE_AZIMUTH), dtype=np.float32)
+            blade = np.zeros((0, N_BLADE_COLUMNS), dtype=np.float32)
     return np.ascontiguousarray(u_ex), vel, psi0, np.ascontiguousarray(blade)
 
 

@@ -55,6 +55,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 from scipy.fft import irfft, next_fast_len, rfft
 
+from .aero import inplane_ring_weights
 from .model import INPUT_BLOCKS
 from .oc3 import WATER_DEPTH
 from .replay import (
@@ -64,8 +65,9 @@ from .replay import (
     _profile_disc_mean,
     advection_delay,
     blade_effective_wind,
+    stepper_blade_winds,
 )
-from .simulate import N_BLADE_AZIMUTH, N_EX, Simulator
+from .simulate import N_BLADE_COLUMNS, N_EX, Simulator
 from .validation import check_number
 from .waves import SparGeometry, _loads_from_transfer_series, _wave_transfer_rows
 from .wind import rotor_averaging, rotor_plane_fit
@@ -179,9 +181,10 @@ class StreamedWind:
         ``"rotor_effective"``: ``effective_column`` (and ``hub_column`` for the ``Wind1VelX`` channel);
         ``"field"``: ``hub_column`` and the polar field in ``field_columns`` (``len(radii) * len(azimuth_rad)``
         columns, ring by ring); ``"given"``: everything precomputed in ``hub_column``, ``effective_column``,
-        ``shear_columns`` (2, or None) and ``field_columns`` (the blade winds at uniform azimuths, or None).
+        ``shear_columns`` (2, or None) and ``field_columns`` (the blade winds at uniform azimuths, or None),
+        ``inplane_columns`` (the in-plane force's blade winds, same azimuths; None: the blade winds stand in).
     hub_column, effective_column : int
-    field_columns : slice, optional
+    field_columns, inplane_columns : slice, optional
     shear_columns : slice, optional
     radii, azimuth_rad : ndarray, optional
         The polar grid (m, rad) of a ``"field"``.
@@ -205,6 +208,7 @@ class StreamedWind:
     effective_column: int = 0
     field_columns: slice | None = None
     shear_columns: slice | None = None
+    inplane_columns: slice | None = None
     radii: np.ndarray | None = None
     azimuth_rad: np.ndarray | None = None
     mean: float | None = None
@@ -367,7 +371,10 @@ class ReplayForcing:
         # Taylor advection from the wind's plane to the rotor (as surrogates.replay.replay_forcing)
         self.wind_delay = advection_delay(sim, x_ref=wind.x_ref)
         # and from the rotor centre to each azimuth of the tilted disc (Simulator.blade_sampling_delay)
-        self.blade_delay = sim.blade_sampling_delay()
+        self.blade_delay = np.tile(sim.blade_sampling_delay(), 2)  # thrust/torque, then in-plane blade winds
+        self.inplane_weights = None
+        if wind.level == "field" and wind.radii is not None:  # the in-plane force's ring weights
+            self.inplane_weights = inplane_ring_weights(wind.radii, lc.wind_speed)[0]
         geo = SparGeometry()
         z, _, _ = geo.strips(sim.strip_z.size)
         self._transfer_z = z
@@ -436,7 +443,7 @@ class ReplayForcing:
         dt = wd.series.dt
         t_rows = wd.series.t0 + np.arange(s0, s0 + block.shape[0]) * dt
         hub = block[:, wd.hub_column]
-        shear_y = shear_z = blade = None
+        shear_y = shear_z = blade = inplane = None
         if wd.level == "hub":
             v = self.wind_mean
 
@@ -453,21 +460,23 @@ class ReplayForcing:
             polar = block[:, wd.field_columns].reshape(block.shape[0], len(wd.radii), len(wd.azimuth_rad))
             eff, shear_y, shear_z = rotor_plane_fit(polar, wd.radii, wd.azimuth_rad,
                                                     radius=max(wd.radius, float(np.max(wd.radii))))
-            blade = blade_effective_wind(polar, wd.radii, wd.azimuth_rad, N_BLADE_AZIMUTH)
+            blade = blade_effective_wind(polar, wd.radii, wd.azimuth_rad, N_BLADE_COLUMNS // 2)
+            inplane = blade_effective_wind(polar, wd.radii, wd.azimuth_rad, N_BLADE_COLUMNS // 2,
+                                           weights=self.inplane_weights)
         else:
             eff = block[:, wd.effective_column]
             if wd.shear_columns is not None:
                 shear_y, shear_z = block[:, wd.shear_columns].T
             if wd.field_columns is not None:
                 blade = block[:, wd.field_columns].astype(np.float32)
+                if wd.inplane_columns is not None:
+                    inplane = block[:, wd.inplane_columns].astype(np.float32)
         inter = [np.interp(t, t_rows, hub), np.interp(t, t_rows, eff)]
         inter += [None, None] if shear_y is None else [np.interp(t, t_rows, shear_y), np.interp(t, t_rows, shear_z)]
         if blade is not None:
-            if blade.shape[1] != N_BLADE_AZIMUTH:
-                blade = blade_effective_wind(blade[:, None, :], np.array([1.0]),
-                                             np.arange(blade.shape[1]) * 2 * np.pi / blade.shape[1], N_BLADE_AZIMUTH)
-            b = np.empty((t.size, N_BLADE_AZIMUTH), dtype=np.float32)
-            for j in range(N_BLADE_AZIMUTH):
+            blade = stepper_blade_winds(blade, inplane)
+            b = np.empty((t.size, N_BLADE_COLUMNS), dtype=np.float32)
+            for j in range(N_BLADE_COLUMNS):
                 b[:, j] = np.interp(t - self.blade_delay[j], t_rows, blade[:, j])
             inter.append(b)
         else:
@@ -482,8 +491,8 @@ class ReplayForcing:
         u_ex : ndarray (n_steps + 1, N_EX)
         vel : ndarray (n_steps + 1, n_strips, 2)
             Wave particle velocities at the drag strips (m/s).
-        blade : ndarray (n_steps + 1, 24) float32, or (0, 24) without a field
-            Blade-effective winds (m/s).
+        blade : ndarray (n_steps + 1, N_BLADE_COLUMNS) float32, or (0, N_BLADE_COLUMNS) without a field
+            Blade-effective winds (m/s): thrust and torque's, then the in-plane force's.
         """
         sim, lc = self.sim, self.sim.case
         assert lc is not None
@@ -524,10 +533,10 @@ class ReplayForcing:
         u_ex[:n_in, i_sh] = shy if shy is not None else sim.mean_shear[0]
         u_ex[:n_in, i_sh + 1] = shz if shz is not None else sim.mean_shear[1]
         if blade_in is not None:
-            blade = np.empty((n, N_BLADE_AZIMUTH), dtype=np.float32)
+            blade = np.empty((n, N_BLADE_COLUMNS), dtype=np.float32)
             blade[:n_in] = blade_in
         else:
-            blade = np.zeros((0, N_BLADE_AZIMUTH), dtype=np.float32)
+            blade = np.zeros((0, N_BLADE_COLUMNS), dtype=np.float32)
         if n_in < n:  # beyond the inputs: hold the last sample (never stepped into: see steps_available)
             u_ex[n_in:] = u_ex[n_in - 1]
             vel[n_in:] = vel[n_in - 1]

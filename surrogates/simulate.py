@@ -24,7 +24,7 @@ import numba
 import numpy as np
 import scipy.linalg as sla
 
-from .aero import rotor_coefficients, rotor_table
+from .aero import inplane_ring_weights, rotor_coefficients, rotor_table
 from .channels import ALL_CHANNELS, UNITS
 from .controller import DISCON, N_CONTROLLER_STATE, discon_step, initial_controller_state
 from .controller import PARAMS as DISCON_PARAMS
@@ -43,11 +43,12 @@ from .model import (
 from .mooring import mooring_loads, mooring_table
 from .oc3 import RHO_AIR
 from .record import Record
+from .replay import blade_effective_wind
 from .structure import _FLAP as FLAP
 from .structure import N_DOF
 from .validation import check_number
 from .waves import synthesize_waves
-from .wind import synthesize_rotor_wind
+from .wind import TURBSIM_GRID_SPACING, synthesize_rotor_wind
 
 
 def mean_shear_z(wind_speed: float, exponent: float = 0.2, hub_height: float = 90.0, radius: float = 63.0) -> float:
@@ -94,7 +95,7 @@ def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: i
 # ------------------------------------------------------------------------------------------------ kernel
 # scalar parameters of the kernel, packed in one float array ``par``
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
-    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_RQ, P_RS, P_RTY, P_SKIN, P_MZG = range(24)
+    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG = range(24)
 N_PAR = 24
 I_ACC = N_CONTROLLER_STATE
 """Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
@@ -104,6 +105,16 @@ FIELD_DT = 0.05
 """Time step (s) of the synthesised turbulent field over the rotor disc."""
 N_BLADE_AZIMUTH = 24
 """Azimuths of the blade-effective wind around the rotor (-)."""
+N_BLADE_COLUMNS = 2 * N_BLADE_AZIMUTH
+"""Columns of the stepper's blade winds: the wind along each blade at ``N_BLADE_AZIMUTH`` azimuths weighted as its
+thrust and torque answer it (radius-weighted), then as its in-plane force does
+(:func:`surrogates.aero.inplane_ring_weights`); a replayed rotor azimuth adds one more column."""
+FIELD_AZIMUTH = 16
+"""Points per ring of the synthesised polar field (-), as the reference runs' ``inflow.npz`` sample the TurbSim grid;
+the blade-effective wind is interpolated from them to ``N_BLADE_AZIMUTH`` azimuths, as in a replay."""
+FIELD_GRID_SPACING = TURBSIM_GRID_SPACING
+"""Resolution (m) of the synthesised turbulence: the field as OpenFAST reads it from the OC3 deck's TurbSim grid,
+by bilinear interpolation (:func:`surrogates.wind.grid_interpolation_variance`)."""
 I_WIND = INPUT_BLOCKS["wind"].start
 I_HUB_WIND = INPUT_BLOCKS["hub_wind"].start
 I_ACTION = INPUT_BLOCKS["action"].start
@@ -241,15 +252,20 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                     i1 = (i0 + 1) % n_az
                     wa = fa - int(fa)
                     v_b = (1.0 - wa) * blade[k, i0] + wa * blade[k, i1]
+                    v_ip = (1.0 - wa) * blade[k, n_az + i0] + wa * blade[k, n_az + i1]
+                    dv_ip = dv + s_asym * (v_ip - wind)
                     dv += s_asym * (v_b - wind)
+                else:
+                    dv_ip = dv
                 d_t = par[P_DTDU] / 3.0 * dv
                 d_q = par[P_DQDU] / 3.0 * dv
                 thrust += d_t
                 q_aero += d_q
                 mt += d_t * par[P_RT] * c_b  # blade at (y, z) = r (-sin, cos): tilt = z F
                 my += d_t * par[P_RTY] * s_b  # yaw = -y F (its own lever: see ROTOR_ASYMMETRY)
-                fy += -d_q / par[P_RQ] * c_b  # in-plane force along the direction of rotation
-                fz += -d_q / par[P_RQ] * s_b
+                f_ip = par[P_GIP] * dv_ip  # the blade's in-plane force, along the direction of rotation
+                fy += -f_ip * c_b
+                fz += -f_ip * s_b
             u[hub0 + 1] += fy
             u[hub0 + 2] += fz
             u[hub0 + 4] += mt
@@ -325,11 +341,11 @@ def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, v
     dt = par[P_DT]
     rotor = par[P_ROTOR] > 0.0
     moor_out = np.zeros(12)
-    measured_azimuth = blade.shape[1] > N_BLADE_AZIMUTH
+    measured_azimuth = blade.shape[1] > N_BLADE_COLUMNS
     for step in range(n_steps):
         k = k0 + step
         if measured_azimuth and blade.shape[0] > k:  # a replay of the rotor's measured azimuth (rad; NaN: none)
-            a = blade[k, N_BLADE_AZIMUTH]
+            a = blade[k, N_BLADE_COLUMNS]
             if a == a:
                 psi = a
         domega = _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_along, drag_across,
@@ -485,7 +501,8 @@ class Simulator:
         if op is not None and self.nonlinear_rotor:
             par[P_SASYM] = float(eff["rotor_asymmetry"])
             par[P_DTDU], par[P_DQDU] = op.dT_dV, op.dQ_dV
-            par[P_RT], par[P_RQ], par[P_RTY] = blade_load_radii(rt.radius)
+            par[P_RT], par[P_RTY] = blade_load_radii(rt.radius)
+            par[P_GIP] = inplane_ring_weights(np.array([0.0, rt.radius]), self.case.wind_speed)[1]
             par[P_RS] = BLADE_SAMPLING_RADIUS * rt.radius
         self.par = par
         self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
@@ -526,7 +543,7 @@ class Simulator:
         """Per-step inputs ``u`` (N_INPUT,) and rotor acceleration at state ``x`` and forcing sample ``k``."""
         u = np.zeros(N_INPUT)
         if blade is None:
-            blade = np.zeros((0, N_BLADE_AZIMUTH), dtype=np.float32)
+            blade = np.zeros((0, N_BLADE_COLUMNS), dtype=np.float32)
         domega = _loads(x, ctrl, k, psi, np.asarray(action, float), u_ex, vel, blade, self.strip_z,
                         *self.drag_arrays,
                         *self.moor_grids, self.moor_tab, self.moor_g0, self.moor_jac, np.zeros(12), self.harm,
@@ -659,23 +676,24 @@ class Simulator:
             u_ex[:, INPUT_BLOCKS["wave"]] = w.excitation[:n] + self.drag.excitation(w.velocity[:n])
             u_ex[:, INPUT_BLOCKS["elev"].start] = w.elevation[:n]
             vel = np.ascontiguousarray(w.velocity[:n])
-        blade = np.zeros((0, N_BLADE_AZIMUTH), dtype=np.float32)
+        blade = np.zeros((0, N_BLADE_COLUMNS), dtype=np.float32)
         if lc is not None and lc.wind_speed > 0:
             # the field at FIELD_DT (its content above ~2 Hz is negligible), interpolated to the internal step
             wd = synthesize_rotor_wind(lc.wind_speed, lc.turbulence_intensity, duration + 2 * FIELD_DT, FIELD_DT,
-                                       seed=int(wind_ss.generate_state(1)[0]), n_azimuth=N_BLADE_AZIMUTH,
-                                       return_field=True)
+                                       seed=int(wind_ss.generate_state(1)[0]), n_azimuth=FIELD_AZIMUTH,
+                                       return_field=True, grid_spacing=FIELD_GRID_SPACING)
             t = np.arange(n) * self.dt_int
             u_ex[:, INPUT_BLOCKS["wind"].start] = np.interp(t, wd.t, wd.rotor_effective) - lc.wind_speed
             u_ex[:, INPUT_BLOCKS["hub_wind"].start] = np.interp(t, wd.t, wd.hub)
             u_ex[:, INPUT_BLOCKS["shear"].start] = np.interp(t, wd.t, wd.shear_y)
             u_ex[:, INPUT_BLOCKS["shear"].start + 1] = np.interp(t, wd.t, wd.shear_z)
-            radii = np.asarray(wd.polar_radii, float)
-            w_r = np.where(radii > 0, radii, 0.0)
-            w_r /= w_r.sum()
-            on_blade = np.einsum("tra,r->ta", wd.polar_u, w_r)  # (n_field, n_azimuth)
+            w_ip = inplane_ring_weights(wd.polar_radii, lc.wind_speed)[0]
+            on_blade = np.concatenate([  # (n_field, N_BLADE_COLUMNS): thrust and torque's, then in-plane
+                blade_effective_wind(wd.polar_u, wd.polar_radii, wd.polar_azimuth_rad, N_BLADE_AZIMUTH),
+                blade_effective_wind(wd.polar_u, wd.polar_radii, wd.polar_azimuth_rad, N_BLADE_AZIMUTH, w_ip)], axis=1)
             # each azimuth meets the frozen field with its own delay (the disc is tilted: blade_sampling_delay)
-            idx = np.clip((t[:, None] - self.blade_sampling_delay()[None, :]) / FIELD_DT, 0.0,
+            delay = np.tile(self.blade_sampling_delay(), 2)
+            idx = np.clip((t[:, None] - delay[None, :]) / FIELD_DT, 0.0,
                           on_blade.shape[0] - 1.0)  # held at the field's ends, as np.interp does in a replay
             i0 = np.minimum(idx.astype(int), on_blade.shape[0] - 2)
             frac = idx - i0

@@ -83,8 +83,12 @@ def test_replayed_forcing_equals_the_synthesised_forcing():
     # at 12 m/s); a measured field is the one crossing the rotor centre's plane: undo them to get it back
     delay = sim.blade_sampling_delay()
     assert 0.3 < delay[0] < 0.7 and delay[0] == pytest.approx(-delay[delay.size // 2])
-    plane = np.stack([np.interp(t + d, t, blade[:, j]) for j, d in enumerate(delay)], axis=1).astype(np.float32)
-    wind = MeasuredWind(t, hub, eff, shear[:, 0], shear[:, 1], plane, level="field", x_ref=None)  # drawn at the rotor
+    # (the blade winds of thrust and torque, then of the in-plane force: N_BLADE_COLUMNS, both delayed alike)
+    assert blade.shape[1] == 2 * delay.size
+    plane = np.stack([np.interp(t + d, t, blade[:, j]) for j, d in enumerate(np.tile(delay, 2))],
+                     axis=1).astype(np.float32)
+    wind = MeasuredWind(t, hub, eff, shear[:, 0], shear[:, 1], plane[:, :delay.size], level="field", x_ref=None,
+                        blade_inplane=plane[:, delay.size:])  # drawn at the rotor
     u2, v2, p2, b2 = replay_forcing(sim, n_steps, 0.0, MeasuredWaves(t, elev), wind,
                                     np.random.SeedSequence(3).spawn(2)[0])
     assert p2 == psi0
