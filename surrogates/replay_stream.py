@@ -373,8 +373,9 @@ class ReplayForcing:
         # and from the rotor centre to each azimuth of the tilted disc (Simulator.blade_sampling_delay)
         self.blade_delay = np.tile(sim.blade_sampling_delay(), 2)  # thrust/torque, then in-plane blade winds
         self.inplane_weights = None
-        if wind.level == "field" and wind.radii is not None:  # the in-plane force's ring weights
-            self.inplane_weights = inplane_ring_weights(wind.radii, lc.wind_speed)[0]
+        if wind.level == "field" and wind.radii is not None:  # the in-plane force's ring weights at the mean hub
+            hub_mean = wind.mean if wind.mean is not None else _column_pass(v, wind.hub_column, 0)[0]
+            self.inplane_weights = inplane_ring_weights(wind.radii, max(float(hub_mean), 0.1))[0]
         geo = SparGeometry()
         z, _, _ = geo.strips(sim.strip_z.size)
         self._transfer_z = z

@@ -24,7 +24,7 @@ import numba
 import numpy as np
 import scipy.linalg as sla
 
-from .aero import inplane_ring_weights, rotor_coefficients, rotor_table
+from .aero import blade_inplane_sensitivity, inplane_ring_weights, rotor_coefficients, rotor_table
 from .channels import ALL_CHANNELS, UNITS
 from .controller import DISCON, N_CONTROLLER_STATE, discon_step, initial_controller_state
 from .controller import PARAMS as DISCON_PARAMS
@@ -95,8 +95,8 @@ def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: i
 # ------------------------------------------------------------------------------------------------ kernel
 # scalar parameters of the kernel, packed in one float array ``par``
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
-    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG = range(24)
-N_PAR = 24
+    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP = range(25)
+N_PAR = 25
 I_ACC = N_CONTROLLER_STATE
 """Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
 accelerations of the previous internal step (m/s^2, rad/s^2), which the CM kinematics (``cm_kinematics``) read."""
@@ -253,10 +253,10 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                     wa = fa - int(fa)
                     v_b = (1.0 - wa) * blade[k, i0] + wa * blade[k, i1]
                     v_ip = (1.0 - wa) * blade[k, n_az + i0] + wa * blade[k, n_az + i1]
-                    dv_ip = dv + s_asym * (v_ip - wind)
+                    dv_ip = dv * par[P_RIP] + s_asym * (v_ip - wind)
                     dv += s_asym * (v_b - wind)
                 else:
-                    dv_ip = dv
+                    dv_ip = dv * par[P_RIP]
                 d_t = par[P_DTDU] / 3.0 * dv
                 d_q = par[P_DQDU] / 3.0 * dv
                 thrust += d_t
@@ -502,8 +502,11 @@ class Simulator:
             par[P_SASYM] = float(eff["rotor_asymmetry"])
             par[P_DTDU], par[P_DQDU] = op.dT_dV, op.dQ_dV
             par[P_RT], par[P_RTY] = blade_load_radii(rt.radius)
-            par[P_GIP] = inplane_ring_weights(np.array([0.0, rt.radius]), self.case.wind_speed)[1]
+            r_node, s_node = blade_inplane_sensitivity(round(self.case.wind_speed, 2))
+            par[P_GIP] = float(s_node.sum())
+            # the disc's tilt and yaw rates load the in-plane force at its own mean radius, not at r_s
             par[P_RS] = BLADE_SAMPLING_RADIUS * rt.radius
+            par[P_RIP] = float(np.sum(s_node * r_node) / s_node.sum()) / par[P_RS]
         self.par = par
         self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
         par[P_SKIN] = float(eff["cm_kinematics"])

@@ -210,7 +210,7 @@ def grid_interpolation_variance(f_hz: np.ndarray, mean_speed: float, spacing: fl
     Examples
     --------
     >>> h = grid_interpolation_variance([0.0, 0.5, 50.0], 12.0, TURBSIM_GRID_SPACING)
-    >>> bool(0.99 < h[0] <= 1.0 and abs(h[2] - 4 / 9) < 1e-12 and h[0] > h[1] > h[2])
+    >>> bool(0.98 < h[0] <= 1.0 and abs(h[2] - 4 / 9) < 1e-12 and h[0] > h[1] > h[2])
     True
     """
     v = check_number("mean_speed", mean_speed, positive=True)

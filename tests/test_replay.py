@@ -110,10 +110,12 @@ def test_self_replay_reproduces_the_record():
     """Closed loop: a surrogate record (rotor_asymmetry off, so the rotor-effective wind is all the wind it sees)
     replayed from its own Wave1Elev and rotor-effective wind into the same model reproduces its platform and
     fore-aft tower channels to R^2 >= 0.99 once the start-up (400 s: heave and surge forget the replay's
-    different first seconds of wave load only at their own slow decay) is discarded. Side-to-side channels are
-    dominated by 3P, whose phase keeps the azimuth offset the start-up's rotor-speed transient leaves: >= 0.95."""
+    different first seconds of wave load only at their own slow decay) is discarded; side-to-side >= 0.95. The
+    azimuth-locked loads (rotor_1p, rotor_3p) are off: their phase keeps the azimuth offset that the start-up's
+    rotor-speed transient leaves (the record carries no azimuth to replay), which takes the 3P-dominated top
+    gauges to R^2 0.7-0.99 depending on the seed."""
     lc = surrogates.operating_case(12.0, 2.5, 10.0)
-    model = surrogates.FOWTModel().with_effects(rotor_asymmetry=0.0)
+    model = surrogates.FOWTModel().with_effects(rotor_asymmetry=0.0, rotor_3p=0.0, rotor_1p=0.0)
     duration = 800.0
     rec = surrogates.simulate(model, lc, duration=duration, transient=0.0, seed=3, noise=False)
     sim, _, u_ex, _, _, _ = _forcing(model, lc, duration)
