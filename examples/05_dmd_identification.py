@@ -24,8 +24,9 @@ What to look for.
 * Damping is harder than frequency. SSI-COV gets the right order; DMD's damping is biased low on randomly excited
   data (its eigenvalues crowd onto the unit circle), so do not trust DMD damping.
 * The 2nd tower modes (2.15 Hz side-to-side, 2.55 Hz fore-aft) are found too, MAC ~ 1. Take that with care:
-  the surrogate's rotationally sampled turbulence drives its 2-3 Hz band several times harder than OpenFAST
-  does (main README, Known limits), so they would be harder to find on OpenFAST data.
+  OpenFAST's tower top carries about three times the surrogate's 2-3 Hz variance, with blade and tower-torsion
+  modes the surrogate does not have between 1.4 and 2.1 Hz (main README, Known limits): on OpenFAST data the
+  band is busier.
 * Both tables list more lines than the model has modes. Each line's ``kind`` names the nearest model mode
   within 10 % (``structural (tower_fa_1)``); lines with none are ``rotor_band (3P)`` when they sit in the band
   a rotor harmonic sweeps (0.58-0.65 Hz here) or ``unmodelled`` otherwise (e.g. DMD's 2.89 Hz, SSI-COV's

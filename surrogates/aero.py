@@ -1,9 +1,17 @@
 """Quasi-steady rotor aerodynamics of the NREL 5 MW and its operating point under the OC3 Hywind controller.
 
 The rotor is described by its steady power, thrust and torque coefficient surfaces ``Cp, Ct, Cq(lambda,
-beta)`` (NREL's ROSCO table ``Cp_Ct_Cq.NREL5MW.txt``, computed with CCBlade from the NREL 5 MW blade; shipped
-in ``surrogates/data`` under Apache-2.0). The simulation evaluates them at every step with the wind relative
-to the moving hub (the ``rotor_nonlinear`` effect, with the controller of :mod:`surrogates.controller`). For
+beta)``: by default the OC3 Hywind reference deck's rotor as OpenFAST's AeroDyn computes it
+(``Cp_Ct_Cq.OC3_AeroDyn.txt``, made by ``tools/aerodyn_rotor_table.py`` with AeroDyn's standalone driver on the
+deck's own AeroDyn input: its unsteady airfoil model ``UA_Mod = 3`` included, which lowers the mean lift of the
+DU airfoils even in steady wind -- the airfoil files' lift slope for UA lies below their static polars -- by
+3.6-5 % of thrust and torque near rated; steady, uniform inflow aligned with the shaft, rigid blades). The
+surrogate applies the shaft tilt, the tower top's pitch and the disc-mean wind of the sheared, turbulent field
+itself. ``rotor_table("ccblade")`` is NREL's ROSCO table (``Cp_Ct_Cq.NREL5MW.txt``, CCBlade, Apache-2.0), which
+already contains a 5 deg tilt and a 0.2 shear exponent and no unsteady aerodynamics: against OpenFAST it made the
+rotor 4-5 % too strong at 12 m/s (steady wind: blade pitch 2.06 deg against OpenFAST's 1.32; 1.69 now). The
+simulation evaluates them at every step with the wind relative to the moving hub (the ``rotor_nonlinear`` effect,
+with the controller of :mod:`surrogates.controller`). For
 the linear model (``linearize()``, modal analysis, ``rotor_nonlinear=0``) thrust and torque are linearised
 about the steady operating point that the same controller reaches at the mean wind:
 
@@ -28,8 +36,8 @@ from scipy.optimize import brentq
 
 from .oc3 import RHO_AIR
 
-__all__ = ["RotorTable", "rotor_table", "OperatingPoint", "operating_point", "RATED", "blade_inplane_sensitivity",
-           "inplane_ring_weights"]
+__all__ = ["ROTOR_TABLES", "RotorTable", "rotor_table", "OperatingPoint", "operating_point", "RATED",
+           "blade_inplane_sensitivity", "inplane_ring_weights"]
 
 RATED = {
     "electrical_power": 5.0e6,  # W (Jonkman et al. 2009, Table 1-1)
@@ -115,15 +123,27 @@ def _read_block(lines: list[str], start: int, n_rows: int) -> np.ndarray:
     return np.array(rows)
 
 
-@lru_cache(maxsize=1)
-def rotor_table() -> RotorTable:
-    """The NREL 5 MW rotor performance table (ROSCO, CCBlade), cached.
+ROTOR_TABLES = {"aerodyn": "data/Cp_Ct_Cq.OC3_AeroDyn.txt", "ccblade": "data/Cp_Ct_Cq.NREL5MW.txt"}
+"""The rotor coefficient tables shipped (see the module docstring): the default, and ROSCO's for comparison."""
+
+
+@lru_cache(maxsize=2)
+def rotor_table(source: str = "aerodyn") -> RotorTable:
+    """The NREL 5 MW rotor performance table, cached.
+
+    Parameters
+    ----------
+    source : {"aerodyn", "ccblade"}
+        ``"aerodyn"`` (default): the OC3 deck's rotor by AeroDyn (unsteady airfoil model on; aligned, uniform,
+        steady inflow); ``"ccblade"``: NREL's ROSCO table (CCBlade; 5 deg tilt and 0.2 shear inside).
 
     Returns
     -------
     RotorTable
     """
-    text = resources.files("surrogates").joinpath("data/Cp_Ct_Cq.NREL5MW.txt").read_text()
+    if source not in ROTOR_TABLES:
+        raise ValueError(f"source must be one of {sorted(ROTOR_TABLES)}, got {source!r}")
+    text = resources.files("surrogates").joinpath(ROTOR_TABLES[source]).read_text()
     lines = text.splitlines()
 
     def after(marker: str) -> int:

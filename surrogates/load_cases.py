@@ -336,7 +336,7 @@ def operating_case(
     --------
     >>> lc = operating_case(8.0, hs=2.0, tp=9.0)
     >>> round(lc.rotor_rpm, 1), round(lc.replace(wind_speed=18.0).rotor_rpm, 1)
-    (9.1, 12.1)
+    (9.0, 12.1)
     """
     v = _real(wind_speed, "wind_speed")
     if v <= 0:
