@@ -87,6 +87,7 @@ __all__ = [
     "as_measured_wind",
     "blade_effective_wind",
     "stepper_blade_winds",
+    "delayed_blade_winds",
     "measured_azimuth",
     "with_measured_azimuth",
     "polar_from_grid",
@@ -726,6 +727,16 @@ def stepper_blade_winds(blade: np.ndarray, inplane: np.ndarray | None = None) ->
     return np.concatenate([resample(blade), resample(blade if inplane is None else inplane)], axis=1)
 
 
+def delayed_blade_winds(t: np.ndarray, delay: np.ndarray, t_src: np.ndarray, blade: np.ndarray) -> np.ndarray:
+    """Blade-wind columns read at ``t - delay[j]`` from series sampled at ``t_src`` (linear, held at the ends):
+    each azimuth of the tilted disc meets the field with its own delay (:meth:`Simulator.blade_sampling_delay`).
+    Returns ``(t.size, n_columns)`` float32 (m/s)."""
+    out = np.empty((t.size, blade.shape[1]), dtype=np.float32)
+    for j in range(blade.shape[1]):
+        out[:, j] = np.interp(t - delay[j], t_src, blade[:, j])
+    return out
+
+
 def replay_forcing(sim: Simulator, n_steps: int, t_start: float, waves: MeasuredWaves | None,
                    wind: MeasuredWind | None, seed_sequence: np.random.SeedSequence,
                    ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
@@ -765,12 +776,8 @@ def replay_forcing(sim: Simulator, n_steps: int, t_start: float, waves: Measured
         u_ex[:, i_sh] = np.interp(tw, wind.t, wind.shear_y) if wind.shear_y is not None else sim.mean_shear[0]
         u_ex[:, i_sh + 1] = np.interp(tw, wind.t, wind.shear_z) if wind.shear_z is not None else sim.mean_shear[1]
         if wind.blade is not None:
-            b = stepper_blade_winds(wind.blade, wind.blade_inplane)
-            blade = np.empty((n, N_BLADE_COLUMNS), dtype=np.float32)
-            # each azimuth of the tilted disc meets the field with its own delay (Simulator.blade_sampling_delay)
             delay = np.tile(sim.blade_sampling_delay(), 2)  # at the load case's wind speed (> 0: checked above)
-            for j in range(N_BLADE_COLUMNS):
-                blade[:, j] = np.interp(tw - delay[j], wind.t, b[:, j])
+            blade = delayed_blade_winds(tw, delay, wind.t, stepper_blade_winds(wind.blade, wind.blade_inplane))
         else:
             blade = np.zeros((0, N_BLADE_COLUMNS), dtype=np.float32)
     return np.ascontiguousarray(u_ex), vel, psi0, np.ascontiguousarray(blade)

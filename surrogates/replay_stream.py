@@ -65,9 +65,10 @@ from .replay import (
     _profile_disc_mean,
     advection_delay,
     blade_effective_wind,
+    delayed_blade_winds,
     stepper_blade_winds,
 )
-from .simulate import N_BLADE_COLUMNS, N_EX, Simulator
+from .simulate import N_BLADE_AZIMUTH, N_BLADE_COLUMNS, N_EX, Simulator
 from .validation import check_number
 from .waves import SparGeometry, _loads_from_transfer_series, _wave_transfer_rows
 from .wind import rotor_averaging, rotor_plane_fit
@@ -461,8 +462,8 @@ class ReplayForcing:
             polar = block[:, wd.field_columns].reshape(block.shape[0], len(wd.radii), len(wd.azimuth_rad))
             eff, shear_y, shear_z = rotor_plane_fit(polar, wd.radii, wd.azimuth_rad,
                                                     radius=max(wd.radius, float(np.max(wd.radii))))
-            blade = blade_effective_wind(polar, wd.radii, wd.azimuth_rad, N_BLADE_COLUMNS // 2)
-            inplane = blade_effective_wind(polar, wd.radii, wd.azimuth_rad, N_BLADE_COLUMNS // 2,
+            blade = blade_effective_wind(polar, wd.radii, wd.azimuth_rad, N_BLADE_AZIMUTH)
+            inplane = blade_effective_wind(polar, wd.radii, wd.azimuth_rad, N_BLADE_AZIMUTH,
                                            weights=self.inplane_weights)
         else:
             eff = block[:, wd.effective_column]
@@ -475,11 +476,7 @@ class ReplayForcing:
         inter = [np.interp(t, t_rows, hub), np.interp(t, t_rows, eff)]
         inter += [None, None] if shear_y is None else [np.interp(t, t_rows, shear_y), np.interp(t, t_rows, shear_z)]
         if blade is not None:
-            blade = stepper_blade_winds(blade, inplane)
-            b = np.empty((t.size, N_BLADE_COLUMNS), dtype=np.float32)
-            for j in range(N_BLADE_COLUMNS):
-                b[:, j] = np.interp(t - self.blade_delay[j], t_rows, blade[:, j])
-            inter.append(b)
+            inter.append(delayed_blade_winds(t, self.blade_delay, t_rows, stepper_blade_winds(blade, inplane)))
         else:
             inter.append(None)
         return tuple(inter)

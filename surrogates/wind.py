@@ -170,6 +170,12 @@ def iec_turbulence_intensity(mean_speed: float, turbulence_class: str = "B") -> 
     return IEC_REFERENCE_INTENSITY[key] * (0.75 * v + 5.6) / v
 
 
+def _coherence_decay(f_hz: np.ndarray, mean_speed: float, coherence_scale: float) -> np.ndarray:
+    """Decay rate ``a(f) = 12 sqrt((f/V)^2 + (0.12/L_c)^2)`` (1/m) of the IEC coherence ``exp(-a(f) r)``
+    (IEC 61400-1 ed. 3, eq. (B.4))."""
+    return 12.0 * np.sqrt((f_hz / mean_speed) ** 2 + (0.12 / coherence_scale) ** 2)
+
+
 TURBSIM_GRID_SPACING = 145.0 / 30.0
 """Spacing (m) of the TurbSim grid of the OC3 Hywind reference runs: 31 x 31 points over 145 m x 145 m."""
 
@@ -216,12 +222,8 @@ def grid_interpolation_variance(f_hz: np.ndarray, mean_speed: float, spacing: fl
     v = check_number("mean_speed", mean_speed, positive=True)
     d = check_number("spacing", spacing, positive=True)
     f = _frequencies(f_hz)
-    lc = turbulence_length_scale(hub_height)
-
-    def coh(dist: float) -> np.ndarray:
-        return np.exp(-12.0 * np.sqrt((f * dist / v) ** 2 + (0.12 * dist / lc) ** 2))
-
-    return 4.0 / 9.0 + 4.0 / 9.0 * coh(d) + 1.0 / 9.0 * coh(np.sqrt(2.0) * d)
+    a = _coherence_decay(f, v, turbulence_length_scale(hub_height))
+    return 4.0 / 9.0 + 4.0 / 9.0 * np.exp(-a * d) + 1.0 / 9.0 * np.exp(-a * np.sqrt(2.0) * d)
 
 
 @lru_cache(maxsize=8)
@@ -300,7 +302,7 @@ def rotor_averaging(
     if isinstance(n_points, bool) or not isinstance(n_points, int | np.integer) or n_points < 32:
         raise ValueError(f"n_points must be an integer >= 32, got {n_points!r}")
     f = _frequencies(f_hz)
-    a = 12.0 * np.sqrt((f / v) ** 2 + (0.12 / lc) ** 2)  # decay rate of the coherence with distance (1/m)
+    a = _coherence_decay(f, v, lc)  # decay rate of the coherence with distance (1/m)
 
     u, wq = _distance_rule(int(n_points))
 
@@ -549,7 +551,7 @@ def _coherent_coefficients(rng: np.random.Generator, f_hz: np.ndarray, amp: np.n
             chunk = max(1, _CHOLESKY_CHUNK * n_points**2 // pts.size**2)
             for start in range(run.start, run.stop, chunk):
                 sl = slice(start, min(start + chunk, run.stop))
-                decay = 12.0 * np.sqrt((f_hz[sl] / mean_speed) ** 2 + (0.12 / coherence_scale) ** 2)
+                decay = _coherence_decay(f_hz[sl], mean_speed, coherence_scale)
                 coh = np.exp(-decay[:, None, None] * d[None, :, :])
                 if nugget is not None:
                     diag = np.arange(pts.size)
