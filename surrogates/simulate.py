@@ -39,6 +39,7 @@ from .model import (
     LinearSystem,
     _as_case,
     blade_load_radii,
+    cyclic_flap_lag,
 )
 from .mooring import mooring_loads, mooring_table
 from .oc3 import RHO_AIR
@@ -95,8 +96,8 @@ def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: i
 # ------------------------------------------------------------------------------------------------ kernel
 # scalar parameters of the kernel, packed in one float array ``par``
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
-    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP = range(25)
-N_PAR = 25
+    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP, P_LAG = range(26)
+N_PAR = 26
 I_ACC = N_CONTROLLER_STATE
 """Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
 accelerations of the previous internal step (m/s^2, rad/s^2), which the CM kinematics (``cm_kinematics``) read."""
@@ -261,8 +262,10 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 d_q = par[P_DQDU] / 3.0 * dv
                 thrust += d_t
                 q_aero += d_q
-                mt += d_t * par[P_RT] * c_b  # blade at (y, z) = r (-sin, cos): tilt = z F
-                my += d_t * par[P_RTY] * s_b  # yaw = -y F (its own lever: see ROTOR_ASYMMETRY)
+                # blade at (y, z) = r (-sin, cos): tilt = z F, yaw = -y F (its own lever: see ROTOR_ASYMMETRY),
+                # carried to the hub by the flap response, which lags the load by P_LAG (cyclic_flap_lag)
+                mt += d_t * par[P_RT] * math.cos(psi_b + par[P_LAG])
+                my += d_t * par[P_RTY] * math.sin(psi_b + par[P_LAG])
                 f_ip = par[P_GIP] * dv_ip  # the blade's in-plane force, along the direction of rotation
                 fy += -f_ip * c_b
                 fz += -f_ip * s_b
@@ -507,6 +510,7 @@ class Simulator:
             # the disc's tilt and yaw rates load the in-plane force at its own mean radius, not at r_s
             par[P_RS] = BLADE_SAMPLING_RADIUS * rt.radius
             par[P_RIP] = float(np.sum(s_node * r_node) / s_node.sum()) / par[P_RS]
+            par[P_LAG] = cyclic_flap_lag(d.blade_flap, op.dT_dV, self.system.rotor_speed)
         self.par = par
         self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
         par[P_SKIN] = float(eff["cm_kinematics"])
