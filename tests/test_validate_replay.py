@@ -58,3 +58,23 @@ def test_replayed_platform_yaw_below_its_mode_matches_openfast_at_every_wind_spe
               if c.channel == "PtfmYaw" and c.statistic == "std:platform"}
     assert set(ratios) == {"c_op08", "c_op12", "c_op18"}
     assert all(0.85 < r < 1.15 for r in ratios.values()), ratios
+
+
+def test_replay_is_compared_over_its_own_span():
+    """A replay drops its start-up; OpenFAST's statistics must then cover the same span of the realisation: a
+    record whose first 100 s hold a slow swing that the replay's span does not contain."""
+    import surrogates
+    from fowt_env import validation as V
+
+    t = np.arange(0.0, 600.0, 0.1)
+    slow = np.where(t < 100.0, 3.0 * np.sin(2 * np.pi * t / 200.0), 0.0)  # only before the replay starts
+    y = slow + 0.1 * np.sin(2 * np.pi * 0.1 * t)
+    rec = surrogates.Record(t, y[:, None], ["PtfmSurge"], ["(m)"])
+    run = V.ReferenceRun("r", "operating", {"wind_speed": 12.0}, rec, statistics={"PtfmSurge": {"std": 1.0}})
+    replayed = rec.slice_time(100.0)
+    window = V.replay_reference_window(run, replayed)
+    assert window.statistics is None
+    assert window.record.t[0] == pytest.approx(100.0) and window.record.t[-1] == pytest.approx(t[-1])
+    # over the window only the 0.1 Hz wave remains: std 0.1 / sqrt(2)
+    assert np.std(window.record["PtfmSurge"]) == pytest.approx(0.1 / np.sqrt(2), rel=0.02)
+    assert V.replay_reference_window(run, rec) is run  # a replay over the whole record changes nothing
