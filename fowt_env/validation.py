@@ -29,10 +29,10 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 import fnmatch
 import inspect
 import json
-import dataclasses
 import math
 import os
 import re
