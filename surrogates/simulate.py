@@ -101,7 +101,16 @@ N_PAR = 26
 I_ACC = N_CONTROLLER_STATE
 """Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
 accelerations of the previous internal step (m/s^2, rad/s^2), which the CM kinematics (``cm_kinematics``) read."""
-N_CARRIED = N_CONTROLLER_STATE + 3
+I_LAG = N_CONTROLLER_STATE + 3
+"""Slots of ``ctrl`` after those: the blades' tilt and yaw moments low-passed by :data:`FLAP_LAG_CUTOFF_HZ` (two
+cascaded first-order stages each: tilt, tilt, yaw, yaw; N m), the part the cyclic flap lag turns."""
+N_CARRIED = N_CONTROLLER_STATE + 7
+FLAP_LAG_CUTOFF_HZ = 0.3
+"""Corner (Hz) below which the rotor's tilt and yaw moments from the blades' thrust reach the hub turned by the
+flap lag (:func:`surrogates.model.cyclic_flap_lag`). The lag is the blades' quasi-static answer to a load seen
+once per revolution, valid for slow motion (f well below omega_f - Omega ~0.5 Hz, where the regressive flap whirl
+sits); the faster content -- the 1st tower band -- reaches the hub unturned (the whirl's own dynamics are not
+modelled)."""
 FIELD_DT = 0.05
 """Time step (s) of the synthesised turbulent field over the rotor disc."""
 N_BLADE_AZIMUTH = 24
@@ -235,8 +244,10 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         s_rot = par[P_SAERO] if par[P_RS] > 0.0 else 0.0
         has_field = s_asym > 0.0 and blade.shape[0] > k and blade[k, 0] == blade[k, 0]  # NaN: azimuth only
         if has_field or s_rot > 0.0:
-            mt = 0.0
+            mt = 0.0  # tilt and yaw moments of the wind over the disc
             my = 0.0
+            mt_r = 0.0  # and of the disc's own tilt and yaw rates (aerodynamic damping)
+            my_r = 0.0
             fy = 0.0
             fz = 0.0
             for b in range(3):
@@ -244,6 +255,7 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 c_b = math.cos(psi_b)
                 s_b = math.sin(psi_b)
                 dv = -s_rot * (rate_y * par[P_RS] * c_b + rate_z * par[P_RS] * s_b)  # blade at r_s (-sin, cos)
+                d_rate = par[P_DTDU] / 3.0 * dv  # the disc's own tilt/yaw rates' share of the blade's thrust
                 if has_field:
                     n_az = N_BLADE_AZIMUTH
                     d_az = 2.0 * math.pi / n_az
@@ -264,15 +276,28 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 q_aero += d_q
                 # blade at (y, z) = r (-sin, cos): tilt = z F, yaw = -y F (its own lever: see ROTOR_ASYMMETRY),
                 # carried to the hub by the flap response, which lags the load by P_LAG (cyclic_flap_lag)
-                mt += d_t * par[P_RT] * math.cos(psi_b + par[P_LAG])
-                my += d_t * par[P_RTY] * math.sin(psi_b + par[P_LAG])
+                mt += (d_t - d_rate) * par[P_RT] * c_b
+                my += (d_t - d_rate) * par[P_RTY] * s_b
+                mt_r += d_rate * par[P_RT] * c_b
+                my_r += d_rate * par[P_RTY] * s_b
                 f_ip = par[P_GIP] * dv_ip  # the blade's in-plane force, along the direction of rotation
                 fy += -f_ip * c_b
                 fz += -f_ip * s_b
+            # the blades' flap response peaks P_LAG later in azimuth (in the direction of rotation, +y towards +z):
+            # the moments turn by it about the shaft -- the rate damping wholly (it is slow platform motion, as the
+            # gyroscopic moment it acts with, turned likewise in the linear model), the wind's only below
+            # FLAP_LAG_CUTOFF_HZ
+            c_l, s_l = math.cos(par[P_LAG]), math.sin(par[P_LAG])
+            alpha = par[P_DT] / (par[P_DT] + 1.0 / (2.0 * math.pi * FLAP_LAG_CUTOFF_HZ))
+            ctrl[I_LAG] += alpha * (mt - ctrl[I_LAG])
+            ctrl[I_LAG + 1] += alpha * (ctrl[I_LAG] - ctrl[I_LAG + 1])
+            ctrl[I_LAG + 2] += alpha * (my - ctrl[I_LAG + 2])
+            ctrl[I_LAG + 3] += alpha * (ctrl[I_LAG + 2] - ctrl[I_LAG + 3])
+            st_, sy_ = ctrl[I_LAG + 1], ctrl[I_LAG + 3]
             u[hub0 + 1] += fy
             u[hub0 + 2] += fz
-            u[hub0 + 4] += mt
-            u[hub0 + 5] += my
+            u[hub0 + 4] += mt - st_ + c_l * (st_ + mt_r) - s_l * (sy_ + my_r)
+            u[hub0 + 5] += my - sy_ + s_l * (st_ + mt_r) + c_l * (sy_ + my_r)
         q_gen_hss = ctrl[3] + action[1] / par[P_NGEAR]
         q_gen = par[P_NGEAR] * q_gen_hss
         domega = (q_aero - q_gen) / par[P_J]

@@ -60,7 +60,9 @@ def test_3p_band_in_side_to_side_tower_top_acceleration(olc7_20min):
 def test_3p_is_a_sharp_line_in_steady_wind():
     steady = load_case(7).replace(turbulence_intensity=0.0)
     rec = surrogates.simulate(surrogates.FOWTModel(), steady, duration=600.0, seed=2)
-    assert psd_peak_ratio(rec["TwHt9ALyt"], rec.fs, 3 * 12.1 / 60.0) > 100.0
+    # a line stands 30-100x above its neighbourhood, a turbulence-broadened 3P a few times (the ratio scatters
+    # with the seed's waves: 87-124 over seeds 2-4 before the flap lag, 88-111 with it; it was asserted > 100)
+    assert psd_peak_ratio(rec["TwHt9ALyt"], rec.fs, 3 * 12.1 / 60.0) > 50.0
 
 
 def test_response_peaks_at_platform_pitch_and_tower_modes(olc7_20min):
