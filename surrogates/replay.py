@@ -504,6 +504,41 @@ class MeasuredWind:
         return cls(tt, u, eff, level="hub", source=source or "hub-height wind", x_ref=x_ref)
 
     @classmethod
+    def from_hub_sheared(cls, t: np.ndarray, hub: np.ndarray, *, shear_exponent: float = 0.2,
+                         hub_height: float = 90.0, radius: float = 63.0, n_radii: int = 5, n_azimuth: int = 24,
+                         source: str = "", x_ref: float | None = 0.0) -> MeasuredWind:
+        """A hub-height wind spread over the disc by the power-law profile: a field ``U_hub(t) (z/H)^alpha``.
+
+        What a steady-wind run with shear (OpenFAST's InflowWind ``WindType = 1``, ``PLExp``) feeds its rotor: the
+        blades meet the profile once per revolution (the mean tilt moment, and with the blades' flap lag a mean
+        yaw moment) and the disc mean is the profile's. Built on a polar grid (``n_radii`` rings to ``radius``,
+        ``n_azimuth`` azimuths) and read as :meth:`from_polar`; level ``"field"``.
+
+        Parameters
+        ----------
+        t, hub : ndarray (n,)
+            Time (s, regular) and hub-height wind (m/s, > 0 on average).
+        shear_exponent : float
+            Power-law exponent (-), >= 0.
+        hub_height, radius : float
+            Hub height and rotor radius (m).
+        """
+        tt, u, _ = _time_series("wind", t, hub)
+        if float(np.mean(u)) <= 0:
+            raise ValueError(f"wind: the mean hub wind must be > 0 m/s, got {float(np.mean(u)):g}")
+        alpha = check_number("shear_exponent", shear_exponent, nonneg=True)
+        h = check_number("hub_height", hub_height, positive=True)
+        rad = check_number("radius", radius, positive=True)
+        if rad >= h:
+            raise ValueError(f"radius ({rad:g} m) must be below the hub height ({h:g} m)")
+        radii = np.linspace(0.0, rad, int(n_radii))
+        psi = np.arange(int(n_azimuth)) * 2.0 * np.pi / int(n_azimuth)
+        profile = ((h + radii[:, None] * np.cos(psi)[None, :]) / h) ** alpha
+        polar = (u[:, None, None] * profile[None, :, :]).astype(np.float32)
+        return cls.from_polar(tt, polar, radii, psi, hub=u, radius=rad, n_azimuth=int(n_azimuth),
+                              source=source or f"hub-height wind with power-law shear {alpha:g}", x_ref=x_ref)
+
+    @classmethod
     def from_rotor_effective(cls, t: np.ndarray, rotor_effective: np.ndarray, hub: np.ndarray | None = None,
                              source: str = "", x_ref: float | None = None) -> MeasuredWind:
         """A rotor-effective wind series (m/s) given directly; ``hub`` (m/s) for the Wind1VelX channel; ``x_ref``

@@ -337,3 +337,30 @@ def test_a_replayed_azimuth_rejects_bad_input():
         surrogates.simulate(model, lc, wind=wind, azimuth=(t[::-1], t * 70.0))
     with pytest.raises(ValueError, match="non-finite"):
         surrogates.simulate(model, lc, wind=wind, azimuth=(t, np.where(t > 5, np.nan, t)))
+
+
+def test_hub_wind_spread_by_a_power_law_shear():
+    """A steady run with shear (InflowWind PLExp): the hub wind over the disc as U (z/H)^alpha. Its plane fit's
+    vertical gradient is the profile's (surrogates.simulate.mean_shear_z, an independent area-weighted fit), its
+    disc mean the profile's mean, and the blades meet more wind at the top than at the bottom."""
+    from surrogates.simulate import mean_shear_z
+
+    t = np.arange(0.0, 60.0, 0.05)
+    hub = np.full(t.size, 12.0)
+    w = MeasuredWind.from_hub_sheared(t, hub, shear_exponent=0.2)
+    assert w.level == "field" and w.blade is not None
+    assert np.allclose(w.shear_z, mean_shear_z(12.0, 0.2), rtol=0.02)
+    assert np.allclose(w.shear_y, 0.0, atol=1e-6)
+    r = np.linspace(0.0, 63.0, 401)[1:]
+    a = np.linspace(0.0, 2 * np.pi, 361)[:-1]
+    rr, aa = np.meshgrid(r, a, indexing="ij")
+    disc_mean = np.sum(rr * 12.0 * ((90.0 + rr * np.cos(aa)) / 90.0) ** 0.2) / np.sum(rr)
+    assert np.allclose(w.rotor_effective, disc_mean, rtol=2e-3)
+    top, bottom = w.blade[0, 0], w.blade[0, w.blade.shape[1] // 2]
+    assert top > 12.0 > bottom
+    flat = MeasuredWind.from_hub_sheared(t, hub, shear_exponent=0.0)
+    assert np.allclose(flat.blade, 12.0) and np.allclose(flat.shear_z, 0.0, atol=1e-6)
+    with pytest.raises(ValueError, match="shear_exponent"):
+        MeasuredWind.from_hub_sheared(t, hub, shear_exponent=-0.1)
+    with pytest.raises(ValueError, match="radius"):
+        MeasuredWind.from_hub_sheared(t, hub, radius=100.0)
