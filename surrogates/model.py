@@ -783,9 +783,13 @@ def cyclic_flap_lag(flap: BladeFlapMode, wind_speed_gain: float, rotor_speed: fl
     (``omega_f`` ~0.7 Hz turning, heavily damped by its own aerodynamics: ``zeta`` ~0.5) answers ``Omega`` with
     the lag ``atan2(2 zeta r, 1 - r^2)``, ``r = Omega / omega_f``, so the moment each blade carries to the hub
     peaks that much later in azimuth (Johnson, *Helicopter Theory*, flapping of a hingeless blade). At rated,
-    19 deg: a tenth of the aerodynamic tilt damping turns into a yaw moment that opposes the gyroscopic one.
-    OpenFAST's steady-wind run shows it: its yaw answers the platform's pitch rate with half the rigid rotor's
-    gain (|yaw / pitch rate| 0.48-0.54 s at 0.08-0.1 Hz, against 0.9-1.1 s with a rigid rotor).
+    18 deg: a third (sin 18 deg) of the aerodynamic tilt damping turns into a yaw moment that opposes the
+    gyroscopic one, which keeps cos 18 deg of itself. OpenFAST's steady-wind run shows it: its yaw answers the
+    platform's pitch rate with half the rigid rotor's gain (|yaw / pitch rate| 0.48-0.54 s at 0.08-0.1 Hz, against
+    0.9-1.1 s with a rigid rotor). The lag is the blades' quasi-static answer, valid for motion well below
+    ``omega_f - Omega`` (~0.5 Hz): the linear model turns the moments by it at every frequency, the simulation
+    turns the rate damping wholly and the wind's moments below ``surrogates.simulate.FLAP_LAG_CUTOFF_HZ``
+    (``tools/cyclic_flap_equations.py`` derives the flap modes that it stands in for).
 
     Parameters
     ----------
