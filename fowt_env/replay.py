@@ -255,7 +255,7 @@ def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: A
         Noise-free; time stamps on the record's own axis, from ``record.t[0] + transient``.
     """
     import surrogates
-    from surrogates.replay import MeasuredWaves, MeasuredWind
+    from surrogates.replay import MeasuredWaves, MeasuredWind, record_wind_plane
 
     from .io import load_record
 
@@ -280,15 +280,18 @@ def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: A
     if model is None:
         model = surrogates.FOWTModel(gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS)
     waves_in = MeasuredWaves.from_record(record) if "Wave1Elev" in record.channels and lc.hs > 0 else None
-    wind_in = wind if wind is not None else (
-        MeasuredWind.from_record(record) if "Wind1VelX" in record.channels and lc.wind_speed > 0 else None)
-    # a run declared with a power-law shear (a steady-wind run's case.json, InflowWind's PLExp) and no field:
-    # the hub wind spread over the disc by that profile, as its rotor met it (the mean tilt and yaw moments)
-    alpha = None if case is None else case.get("shear_exponent")
-    if wind is None and wind_in is not None and alpha is not None and float(alpha) > 0:
-        wind_in = MeasuredWind.from_hub_sheared(np.asarray(record.t), np.asarray(record["Wind1VelX"]),
-                                                shear_exponent=float(alpha), x_ref=wind_in.x_ref,
-                                                source=f"record channel Wind1VelX, power-law shear {float(alpha):g}")
+    wind_in = wind
+    if wind_in is None and "Wind1VelX" in record.channels and lc.wind_speed > 0:
+        # a run declared with a power-law shear (a steady-wind run's case.json, InflowWind's PLExp) and no field:
+        # the hub wind spread over the disc by that profile, as its rotor met it (the mean tilt and yaw moments)
+        alpha = float((case or {}).get("shear_exponent") or 0.0)
+        if alpha > 0:
+            wind_in = MeasuredWind.from_hub_sheared(
+                np.asarray(record.t), np.asarray(record["Wind1VelX"]), shear_exponent=alpha,
+                x_ref=record_wind_plane(getattr(record, "meta", None)),
+                source=f"record channel Wind1VelX, power-law shear {alpha:g}")
+        else:
+            wind_in = MeasuredWind.from_record(record)
     if waves_in is None and wind_in is None:
         raise ValueError("the record has neither a wave elevation (Wave1Elev) nor a wind (Wind1VelX) to replay")
     init = record_initial(record) if initial else None

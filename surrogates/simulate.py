@@ -96,8 +96,11 @@ def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: i
 # ------------------------------------------------------------------------------------------------ kernel
 # scalar parameters of the kernel, packed in one float array ``par``
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
-    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP, P_LAG = range(26)
-N_PAR = 26
+    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP, P_LAGC, P_LAGS, \
+    P_LAGA = range(28)
+N_PAR = 28
+"""(P_LAGC, P_LAGS: cosine and sine of the blades' flap lag; P_LAGA: the gain of one step of each first-order
+stage at FLAP_LAG_CUTOFF_HZ, dt / (dt + 1 / (2 pi f_c)).)"""
 I_ACC = N_CONTROLLER_STATE
 """Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
 accelerations of the previous internal step (m/s^2, rad/s^2), which the CM kinematics (``cm_kinematics``) read."""
@@ -275,7 +278,7 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 thrust += d_t
                 q_aero += d_q
                 # blade at (y, z) = r (-sin, cos): tilt = z F, yaw = -y F (its own lever: see ROTOR_ASYMMETRY),
-                # carried to the hub by the flap response, which lags the load by P_LAG (cyclic_flap_lag)
+                # carried to the hub by the flap response, which lags the load (cyclic_flap_lag)
                 mt += (d_t - d_rate) * par[P_RT] * c_b
                 my += (d_t - d_rate) * par[P_RTY] * s_b
                 mt_r += d_rate * par[P_RT] * c_b
@@ -283,12 +286,11 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 f_ip = par[P_GIP] * dv_ip  # the blade's in-plane force, along the direction of rotation
                 fy += -f_ip * c_b
                 fz += -f_ip * s_b
-            # the blades' flap response peaks P_LAG later in azimuth (in the direction of rotation, +y towards +z):
+            # the blades' flap response peaks the lag later in azimuth (in the direction of rotation, +y to +z):
             # the moments turn by it about the shaft -- the rate damping wholly (it is slow platform motion, as the
             # gyroscopic moment it acts with, turned likewise in the linear model), the wind's only below
             # FLAP_LAG_CUTOFF_HZ
-            c_l, s_l = math.cos(par[P_LAG]), math.sin(par[P_LAG])
-            alpha = par[P_DT] / (par[P_DT] + 1.0 / (2.0 * math.pi * FLAP_LAG_CUTOFF_HZ))
+            c_l, s_l, alpha = par[P_LAGC], par[P_LAGS], par[P_LAGA]
             ctrl[I_LAG] += alpha * (mt - ctrl[I_LAG])
             ctrl[I_LAG + 1] += alpha * (ctrl[I_LAG] - ctrl[I_LAG + 1])
             ctrl[I_LAG + 2] += alpha * (my - ctrl[I_LAG + 2])
@@ -512,6 +514,8 @@ class Simulator:
         d = st.data
         par = np.zeros(N_PAR)
         par[P_DT] = self.dt_int
+        par[P_LAGC] = 1.0  # no flap lag until the nonlinear rotor's operating point sets it
+        par[P_LAGA] = self.dt_int / (self.dt_int + 1.0 / (2.0 * math.pi * FLAP_LAG_CUTOFF_HZ))
         par[P_SMOOR] = float(eff["mooring_nonlinear"])
         par[P_SDRAG] = float(eff["quadratic_drag"])
         par[P_ZF] = zf
@@ -535,7 +539,8 @@ class Simulator:
             # the disc's tilt and yaw rates load the in-plane force at its own mean radius, not at r_s
             par[P_RS] = BLADE_SAMPLING_RADIUS * rt.radius
             par[P_RIP] = float(np.sum(s_node * r_node) / s_node.sum()) / par[P_RS]
-            par[P_LAG] = cyclic_flap_lag(d.blade_flap, op.dT_dV, self.system.rotor_speed)
+            lag = cyclic_flap_lag(d.blade_flap, op.dT_dV, self.system.rotor_speed)
+            par[P_LAGC], par[P_LAGS] = math.cos(lag), math.sin(lag)
         self.par = par
         self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
         par[P_SKIN] = float(eff["cm_kinematics"])
