@@ -65,8 +65,9 @@ BELOW_RATED_WIND = 8.0  # m/s, region 2 of the controller (rated wind 11.4 m/s)
 OC3_REFERENCE_HZ = {
     "surge": 0.0080, "sway": 0.0080, "heave": 0.0324, "roll": 0.0342, "pitch": 0.0343, "yaw": 0.1210,
     "tower_fa_1": 0.483, "tower_ss_1": 0.492, "tower_fa_2": 2.554, "tower_ss_2": 2.053,
-    # 1st collective blade flap, parked (FAST; Jonkman et al. 2009, NREL/TP-500-38060, Table 9-1)
-    "blade_flap": 0.6993,
+    # 1st blade flap, parked: collective, asymmetric pitch (tilt) and yaw (FAST; Jonkman et al. 2009,
+    # NREL/TP-500-38060, Table 9-1; land-based: on the spar the rotor plane's yaw is freer, which raises the yaw one)
+    "blade_flap": 0.6993, "blade_flap_tilt": 0.6675, "blade_flap_yaw": 0.6664,
 }
 FA_MODES = ("surge", "pitch", "tower_fa_1", "tower_fa_2")  # displacements along x (downwind)
 SS_MODES = ("sway", "roll", "tower_ss_1", "tower_ss_2")  # displacements along y (to port)
@@ -103,13 +104,13 @@ def main(quick: bool = False, out: str = ".") -> dict:
         return float(analysis.damping_ratios[analysis.labels.index(lab)])
 
     print("damping ratio zeta; 'no aero': the same operating point with aero_damping off")
-    print(f"{'mode':<12}{'parked f (Hz)':>14}{'OC3 ref (Hz)':>14}{'diff':>8}{'zeta parked':>13}"
+    print(f"{'mode':<16}{'parked f (Hz)':>14}{'OC3 ref (Hz)':>14}{'diff':>8}{'zeta parked':>13}"
           f"{case.name + ' ' + str(case.wind_speed) + ' m/s':>18}{'no aero':>9}"
           f"{str(below.wind_speed) + ' m/s':>10}{'no aero':>9}")
     for lab, f, z in zip(parked.labels, parked.frequencies_hz, parked.damping_ratios, strict=True):
         ref = OC3_REFERENCE_HZ[lab]
         zs = [zeta(a, lab) for a in (operating, operating_no_aero, below_rated, below_rated_no_aero)]
-        print(f"{lab:<12}{f:>14.4f}{ref:>14.4f}{100 * (f / ref - 1):>+7.1f}%{100 * z:>12.2f}%"
+        print(f"{lab:<16}{f:>14.4f}{ref:>14.4f}{100 * (f / ref - 1):>+7.1f}%{100 * z:>12.2f}%"
               f"{100 * zs[0]:>17.2f}%{100 * zs[1]:>8.2f}%{100 * zs[2]:>9.2f}%{100 * zs[3]:>8.2f}%")
 
     # the poles of the linearised state space are the modes

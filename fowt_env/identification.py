@@ -478,7 +478,8 @@ def label_against_model(rows: list[dict], model_modes: list[tuple[str, float]], 
         ``rows``: each ``"structural"`` row within ``max_freq_rel`` of a model mode gains ``model_mode`` (the
         nearest mode's label; :func:`identify` then names the reference mode a line is paired with, by frequency
         and shape, instead); the others become ``"rotor_band"`` (with ``rotor_order``, the lowest order whose
-        band, widened by ``max_freq_rel``, holds the line) or ``"unmodelled"``.
+        band, widened by ``max_freq_rel``, holds the line) or ``"unmodelled"``. A line inside a rotor band (not
+        widened) whose nearest model mode lies outside that band is the band's.
     """
     known = [(lab, f) for lab, f in model_modes if f > 0]
     for row in rows:
@@ -486,6 +487,14 @@ def label_against_model(rows: list[dict], model_modes: list[tuple[str, float]], 
             continue
         f = float(row["frequency_hz"])
         near = min(known, key=lambda m: abs(f - m[1]) / m[1], default=None)
+        # a line inside a rotor band whose nearest model mode lies outside it is the band's (the 3P band of a
+        # turbulent rotor sits within 10 % of the operating tower mode)
+        inside = next((k for k, (lo, hi) in sorted((bands or {}).items()) if lo <= f <= hi), None)
+        if (inside is not None and near is not None
+                and not bands[inside][0] <= near[1] <= bands[inside][1]):
+            row["kind"] = "rotor_band"
+            row["rotor_order"] = int(inside)
+            continue
         if near is not None and abs(f - near[1]) <= max_freq_rel * near[1]:
             row["model_mode"] = near[0]
             continue

@@ -1,8 +1,8 @@
 """``FOWTModel``: the OC3 Hywind surrogate as a state-space system with switchable physical effects.
 
-State ``x`` (24): generalised displacements ``q`` (11, see :data:`surrogates.structure.DOF_LABELS`), their
+State ``x`` (28): generalised displacements ``q`` (13, see :data:`surrogates.structure.DOF_LABELS`), their
 rates, the rotor-speed deviation ``dOmega`` (rad/s) and the integral of it ``xi`` (rad, the pitch controller's
-integrator). Inputs ``u`` (36), in blocks:
+integrator). Inputs ``u`` (38), in blocks:
 
 =========  =====  ===========================================================================
 block      size   meaning (SI)
@@ -16,7 +16,8 @@ shear      2      linear gradients of the streamwise wind over the rotor disc, `
                   the rotor's yaw and tilt moments and side force (the ``rotor_asymmetry`` effect)
 action     2      collective blade-pitch offset (rad), generator-torque offset (N·m, low-speed shaft)
 hub        6      rotor harmonic loads at the hub, global axes (N, N·m): the 1P/3P/6P effects
-nonlinear  11     generalised forces of the nonlinear effects (drag, catenary mooring)
+nonlinear  13     generalised forces of the nonlinear effects (drag, catenary mooring, the sampled rotor's loads on
+                  the blades' cyclic flap modes)
 rotor      5      quantities evaluated per step: blade pitch (rad), generator torque (N·m, HSS), electrical
                   power (W), aerodynamic thrust (N) of the nonlinear rotor (``rotor_nonlinear``; they reach the
                   outputs only, their loads enter through ``hub``), and ``V|V|`` of the hub-height wind
@@ -30,6 +31,7 @@ simulator and enter through the ``hub`` and ``nonlinear`` input blocks.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -47,7 +49,7 @@ from .hydro_axes import platform_in_fixed_axes
 from .load_cases import LoadCase, load_case
 from .oc3 import GRAVITY, BladeFlapMode
 from .radiation import modal_radiation_damping
-from .structure import _FLAP, DOF_LABELS, N_DOF, Structure, build_structure
+from .structure import _CYCLIC, _FLAP, DOF_LABELS, N_DOF, Structure, build_structure
 
 __all__ = ["FOWTModel", "ModalResult", "LinearSystem", "RotorHarmonics", "SensorNoise", "STATE_NAMES", "INPUT_NAMES"]
 
@@ -406,6 +408,7 @@ class FOWTModel:
         # the turning blades' flap mode stiffens with the centrifugal tension (rotor speed of the operating point)
         k[_FLAP, _FLAP] += st.data.n_blades * st.data.blade_flap.centrifugal * omega0**2
         c = st.damping.copy()
+        _cyclic_flap_terms(st, omega0, s_gyro, k, c)
         e_s = st.shaft_axis
         h_v = e_s @ st.hub_translation  # hub velocity along the shaft per qdot == generalised thrust direction
         r_s = e_s @ st.tower_top_rotation  # generalised force of a moment about the shaft at the tower top
@@ -460,19 +463,52 @@ class FOWTModel:
         f_u[:, INPUT_BLOCKS["nonlinear"]] += np.eye(N_DOF)
         # rotor asymmetry: hub loads per unit disc gradient of the wind, (force, moment) per column
         # (the simulation's nonlinear rotor samples the turbulent field blade by blade instead)
-        # the blades' flap lag turns the once-per-revolution tilt and yaw moments about the shaft (cyclic_flap_lag)
-        lag = _about_axis(e_s, cyclic_flap_lag(st.data.blade_flap, op.dT_dV, omega0)) if op is not None else np.eye(3)
-        shear_loads = _shear_hub_loads(op, st.data.tip_radius, 0.0 if nonlinear_rotor else eff["rotor_asymmetry"])
+        # (the blades' cyclic flap modes carry them to the hub with the lag of their response: cyclic_flap_lag)
+        s_shear = 0.0 if nonlinear_rotor else eff["rotor_asymmetry"]
+        shear_loads = _shear_hub_loads(op, st.data.tip_radius, s_shear)
         sh = INPUT_BLOCKS["shear"]
         for col, (force, moment) in zip(range(sh.start, sh.stop), shear_loads, strict=True):
-            f_u[:, col] += j_hub.T @ force + r_tt.T @ lag @ moment
+            f_u[:, col] += j_hub.T @ force + r_tt.T @ moment
+        # ... and load the cyclic flap modes: a gradient g over the disc meets blade b at the sampling radius r_s
+        # as g r_s cos(psi_b) (dU/dz) or -g r_s sin(psi_b) (dU/dy); its thrust acts on the flap mode at the
+        # thrust's centre (thrust_shape)
+        cyc_gain = np.zeros(2)  # generalised force on (tilt, yaw) cyclic flap per unit (dU/dz, -dU/dy)
+        flap = st.data.blade_flap
+        v_t, w_t, v_y, w_y = cyclic_flap_aero_shares(st.data.tip_radius)
+        if op is not None:
+            r_s = BLADE_SAMPLING_RADIUS * st.data.tip_radius
+            cyc_gain[:] = 1.5 * op.dT_dV / 3.0 * flap.thrust_shape * r_s * np.array([w_t, w_y])
+            f_u[_CYCLIC[1], sh.start] += -s_shear * cyc_gain[1]
+            f_u[_CYCLIC[0], sh.start + 1] += s_shear * cyc_gain[0]
         # the rotor's aerodynamic damping of tilt and yaw: a disc turning at (pitch rate, yaw rate) meets the
         # relative-wind gradients dU/dy = +yaw rate, dU/dz = -pitch rate, loaded as any disc gradient (the
         # simulation's nonlinear rotor does the same blade by blade)
         rate_rows = (r_tt[2], -r_tt[1])
         motion_loads = _shear_hub_loads(op, st.data.tip_radius, 0.0 if nonlinear_rotor else s_aero)
         for rows, (force, moment) in zip(rate_rows, motion_loads, strict=True):
-            f_x[:, N_DOF:2 * N_DOF] += np.outer(j_hub.T @ force + r_tt.T @ lag @ moment, rows)
+            f_x[:, N_DOF:2 * N_DOF] += np.outer(j_hub.T @ force + r_tt.T @ moment, rows)
+        # the disc's rates load the cyclic flap modes as any gradient does; the blades' own flap velocity in the
+        # rotating frame, (q_t' + Omega q_y) cos psi_b + (q_y' - Omega q_t) sin psi_b at the thrust's centre, is
+        # a relative wind too: it damps the cyclic modes and carries tilt and yaw moments to the hub
+        cyc_x = np.zeros((N_DOF, n_x))  # generalised forces of the cyclic flap aerodynamics over [x]
+        cyc_moment_x = np.zeros((3, n_x))  # and their tilt and yaw moments on the hub
+        if op is not None and not nonlinear_rotor and s_aero:
+            g_b = s_aero * op.dT_dV / 3.0
+            r_t, r_ty = blade_load_radii(st.data.tip_radius)
+            it, iy = _CYCLIC
+            cyc_x[it, N_DOF:2 * N_DOF] += -s_aero * cyc_gain[0] * r_tt[1]
+            cyc_x[iy, N_DOF:2 * N_DOF] += -s_aero * cyc_gain[1] * r_tt[2]
+            p_t = flap.thrust_shape
+            vel_t = np.zeros(n_x)  # rotating-frame flap velocity projected on cos psi_b (tilt), then sin (yaw)
+            vel_y = np.zeros(n_x)
+            vel_t[N_DOF + it], vel_t[iy] = 1.0, omega0
+            vel_y[N_DOF + iy], vel_y[it] = 1.0, -omega0
+            cyc_x[it] += -1.5 * g_b * p_t * p_t * vel_t
+            cyc_x[iy] += -1.5 * g_b * p_t * p_t * vel_y
+            cyc_moment_x[1] = -1.5 * g_b * p_t * v_t * r_t * vel_t
+            cyc_moment_x[2] = -1.5 * g_b * p_t * v_y * r_ty * vel_y
+            cyc_x += r_tt.T @ cyc_moment_x
+            f_x += cyc_x
         # tower drag: generalised force per unit V|V| of the hub wind
         itd = INPUT_BLOCKS["rotor"].start + 4
         twr_z, twr_f = _tower_drag_strips(st.data.tower_base_height, st.data.tower_top_height, eff["tower_drag"])
@@ -480,7 +516,7 @@ class FOWTModel:
             f_u[:, itd] += f_s * st.point_translation(z_s)[0]
         if op is not None and s_gyro:
             h0 = st.spin_inertia * omega0
-            gyro = s_gyro * h0 * r_tt.T @ lag @ _skew(e_s) @ r_tt
+            gyro = s_gyro * h0 * r_tt.T @ _skew(e_s) @ r_tt
             f_x[:, N_DOF:2 * N_DOF] += gyro
 
         minv = np.linalg.inv(m)
@@ -519,6 +555,14 @@ class FOWTModel:
         t_ref = op.thrust if op is not None else 0.0  # thrust of the geometric (deflection) moment term
         z_top = st.data.tower_top_height
         points = [(f"TwHt{gi}", h) for gi, h in enumerate(self.gauge_heights, start=1)]
+        s1 = 1.5 * st.data.blade_flap.rotary_moment
+        it, iy = _CYCLIC
+        cyc_reaction_x = cyc_moment_x.copy()
+        cyc_reaction_u = np.zeros((3, n_u))
+        for axis, j, other, sign in ((1, it, iy, 1.0), (2, iy, it, -1.0)):
+            cyc_reaction_x[axis] -= s1 * qdd_x[j]
+            cyc_reaction_x[axis, N_DOF + other] -= s1 * sign * 2.0 * s_gyro * omega0
+            cyc_reaction_u[axis] -= s1 * qdd_u[j]
         points += [("TwrBs", st.data.tower_base_height), ("YawBr", z_top)]
         for prefix, h in points:
             t_h = st.point_translation(h)
@@ -547,6 +591,9 @@ class FOWTModel:
                 mom_u += inertial @ qdd_u
                 mom_u[:, 0] += lever @ (-body.mass * GRAVITY * ez)
                 mom_x[:, :N_DOF] += s_pd * body.mass * GRAVITY * _skew(ez) @ (body.translation - t_h)
+            # the cyclic flap modes' inertial and Coriolis reaction on the hub, and their aerodynamic moments
+            mom_x += cyc_reaction_x
+            mom_u += cyc_reaction_u
             lever_hub = _skew(p_hub - p_h)
             mom_x += np.outer(lever_hub @ e_s, thrust_x)
             mom_u += np.outer(lever_hub @ e_s, thrust_u)
@@ -760,6 +807,23 @@ def blade_load_radii(radius: float) -> tuple[float, float]:
     return r_t, r_ty
 
 
+def cyclic_flap_aero_shares(radius: float) -> tuple[float, float, float, float]:
+    """How the blades' cyclic flap meets the rotor's once-per-revolution aerodynamics (-): ``(v_t, w_t, v_y,
+    w_y)``, multiples of the flap mode's value at the thrust's centre, for the tilt (``_t``) and yaw (``_y``) modes.
+
+    Each blade's thrust is sampled at ``r_s`` (:data:`BLADE_SAMPLING_RADIUS`) and carries its moment at ``r_T``
+    (:func:`blade_load_radii`, calibrated), so the rotor's tilt damping is ``1.5 (dT/dU / 3) r_s r_T``. A lumped
+    aerodynamic point must see the flap velocity at ``v`` and load the flap mode at ``w`` with ``r_T v = r_s w``
+    (the aerodynamic damping matrix of tilt and flap symmetric, hence positive semi-definite: with ``r_s != r_T``
+    and ``v = w = 1`` it is indefinite and feeds energy into the whirl) and ``v w = 1`` (the flap's own damping
+    is each blade's ``dT/dU / 3 thrust_shape^2``, as for the collective mode): ``v = sqrt(r_s / r_T)``,
+    ``w = sqrt(r_T / r_s)``.
+    """
+    r_s = BLADE_SAMPLING_RADIUS * radius
+    r_t, r_ty = blade_load_radii(radius)
+    return math.sqrt(r_s / r_t), math.sqrt(r_t / r_s), math.sqrt(r_s / r_ty), math.sqrt(r_ty / r_s)
+
+
 def inplane_gradient_gain(wind_speed: float) -> float:
     """The rotor's in-plane force per unit linear wind gradient over the disc (N·s): ``1.5 G r_ip``.
 
@@ -775,21 +839,19 @@ def inplane_gradient_gain(wind_speed: float) -> float:
 
 
 def cyclic_flap_lag(flap: BladeFlapMode, wind_speed_gain: float, rotor_speed: float) -> float:
-    """Lag (rad) of the blades' flap response to a once-per-revolution load: the rotor's tilt and yaw moments
-    turn by it about the shaft, in the direction of rotation.
+    """Lag (rad) of the blades' flap response to a once-per-revolution load (closed form): the phase by which a
+    blade's deflection peaks later in azimuth than a load that varies over the disc.
 
     A load that varies over the disc (the thrust of a wind gradient, of the disc's own tilt and yaw rates, the
     Coriolis loads of the gyroscopic moment) is seen by each blade once per revolution; the blade's flap mode
     (``omega_f`` ~0.7 Hz turning, heavily damped by its own aerodynamics: ``zeta`` ~0.5) answers ``Omega`` with
-    the lag ``atan2(2 zeta r, 1 - r^2)``, ``r = Omega / omega_f``, so the moment each blade carries to the hub
-    peaks that much later in azimuth (Johnson, *Helicopter Theory*, flapping of a hingeless blade). At rated,
-    18 deg: a third (sin 18 deg) of the aerodynamic tilt damping turns into a yaw moment that opposes the
-    gyroscopic one, which keeps cos 18 deg of itself. OpenFAST's steady-wind run shows it: its yaw answers the
-    platform's pitch rate with half the rigid rotor's gain (|yaw / pitch rate| 0.48-0.54 s at 0.08-0.1 Hz, against
-    0.9-1.1 s with a rigid rotor). The lag is the blades' quasi-static answer, valid for motion well below
-    ``omega_f - Omega`` (~0.5 Hz): the linear model turns the moments by it at every frequency, the simulation
-    turns the rate damping wholly and the wind's moments below ``surrogates.simulate.FLAP_LAG_CUTOFF_HZ``
-    (``tools/cyclic_flap_equations.py`` derives the flap modes that it stands in for).
+    the lag ``atan2(2 zeta r, 1 - r^2)``, ``r = Omega / omega_f`` (Johnson, *Helicopter Theory*, flapping of a
+    hingeless blade): 18 deg at rated. The model does not apply it: its cyclic flap modes (multi-blade coordinates
+    ``blade_flap_tilt``, ``blade_flap_yaw``, :func:`_cyclic_flap_terms`) produce it, and their whirl at
+    ``omega_f +- Omega`` besides; this is their static answer, which ``tests/test_yaw_dynamics.py`` checks them
+    against. Through the blades' aerodynamic moments it turns a third (sin 18 deg) of the rotor's tilt damping
+    into a yaw moment that opposes the gyroscopic one: OpenFAST's steady-wind yaw answers the platform's pitch
+    rate with half the rigid rotor's gain (|yaw / pitch rate| 0.48-0.54 s at 0.08-0.1 Hz).
 
     Parameters
     ----------
@@ -817,10 +879,32 @@ def cyclic_flap_lag(flap: BladeFlapMode, wind_speed_gain: float, rotor_speed: fl
     return float(np.arctan2(2.0 * zeta * r, 1.0 - r * r))
 
 
-def _about_axis(axis: np.ndarray, angle: float) -> np.ndarray:
-    """Rotation matrix by ``angle`` (rad) about the unit vector ``axis`` (Rodrigues)."""
-    a = _skew(np.asarray(axis, dtype=float))
-    return np.eye(3) + np.sin(angle) * a + (1.0 - np.cos(angle)) * (a @ a)
+def _cyclic_flap_terms(st: Structure, omega: float, s_gyro: float, k: np.ndarray, c: np.ndarray) -> None:
+    """Add the rotor speed's terms of the cyclic flap modes to ``k`` and ``c`` in place.
+
+    Each blade's flap equation ``m_f q_b'' + c_f q_b' + k_r q_b + S1 (theta'' cos psi_b + psi'' sin psi_b
+    - 2 Omega theta' sin psi_b + 2 Omega psi' cos psi_b) = F_b`` (``k_r`` with the centrifugal stiffening, ``S1 =
+    int m phi r dr``; tools/cyclic_flap_equations.py) in the multi-blade coordinates ``q_b = q_t cos psi_b + q_y
+    sin psi_b`` is time-invariant: the modes whirl at ``omega_f +- Omega`` (gyroscopic ``3 m_f Omega``, stiffness
+    ``3/2 (k_r - m_f Omega^2)``, the structural damping's ``3/2 c_f Omega``) and the disc's tilt and yaw rates
+    drive them through the Coriolis terms ``3 S1 Omega`` (the ``gyroscopic`` effect's strength ``s_gyro``),
+    which return on the hub as their skew-symmetric reaction.
+    """
+    if not omega:
+        return
+    flap = st.data.blade_flap
+    it, iy = _CYCLIC
+    c_f = 2.0 * flap.damping_ratio * np.sqrt(flap.stiffness * flap.mass)
+    for j in _CYCLIC:
+        k[j, j] += 1.5 * (flap.centrifugal - flap.mass) * omega**2
+    k[it, iy] += 1.5 * c_f * omega
+    k[iy, it] -= 1.5 * c_f * omega
+    c[it, iy] += 3.0 * flap.mass * omega
+    c[iy, it] -= 3.0 * flap.mass * omega
+    g = 3.0 * s_gyro * flap.rotary_moment * omega
+    r_y, r_z = st.tower_top_rotation[1], st.tower_top_rotation[2]
+    e_t, e_y = np.eye(N_DOF)[it], np.eye(N_DOF)[iy]
+    c += g * (np.outer(e_t, r_z) - np.outer(r_z, e_t)) - g * (np.outer(e_y, r_y) - np.outer(r_y, e_y))
 
 
 def _shear_hub_loads(op: OperatingPoint | None, radius: float, strength: float):

@@ -55,6 +55,13 @@ class BladeFlapMode:
         (kg): the rotating blade's stiffness is ``stiffness + Omega^2 centrifugal``.
     first_moment : float
         ``int m phi dr`` (kg): couples the mode with the hub's motion along the shaft.
+    rotary_moment : float
+        ``int m phi r dr`` (kg m), ``r`` from the rotor's centre: couples the blade's flap with the rotor plane's
+        tilt and yaw (the cyclic flap modes, :mod:`surrogates.structure`).
+    shape_coefficients : tuple of float
+        ``BldFl1Sh(2..6)``: ``phi(x) = sum_k c_k x^(k+2)``.
+    span : (float, float)
+        Root and tip radii (m) from the rotor's centre.
     thrust_shape : float
         Mode value at the thrust's centre, ``int phi r dr / int r dr`` (-) for a thrust growing linearly with
         radius: the generalised force of the rotor thrust on the mode per newton, and the share of the tip's
@@ -75,6 +82,15 @@ class BladeFlapMode:
     first_moment: float
     thrust_shape: float
     damping_ratio: float
+    rotary_moment: float = 0.0
+    shape_coefficients: tuple[float, ...] = ()
+    span: tuple[float, float] = (0.0, 1.0)
+
+    def shape(self, radius: np.ndarray) -> np.ndarray:
+        """The mode shape (tip = 1) at radii from the rotor's centre (m); 0 inboard of the root."""
+        r0, r1 = self.span
+        x = np.clip((np.asarray(radius, dtype=float) - r0) / (r1 - r0), 0.0, 1.0)
+        return sum(c * x ** (k + 2) for k, c in enumerate(self.shape_coefficients))
 
     def frequency_hz(self, rotor_rpm: float) -> float:
         """Natural frequency of the blade's flap mode on a rigid hub (Hz) at a rotor speed (rpm)."""
@@ -103,6 +119,9 @@ def _blade_flap_mode(bl: dict[str, str], blade: np.ndarray, hub_r: float, tip: f
         first_moment=float(np.trapezoid(m * phi, r)),
         thrust_shape=float(np.trapezoid(phi * r, r) / np.trapezoid(r, r)),
         damping_ratio=_number(bl, "BldFlDmp(1)") / 100.0,
+        rotary_moment=float(np.trapezoid(m * phi * r, r)),
+        shape_coefficients=tuple(float(c) for c in coeffs),
+        span=(float(hub_r), float(tip)),
     )
 
 

@@ -14,6 +14,7 @@ the rotor's initial azimuth and the sensor noise -- the same seed gives the same
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 from collections.abc import Callable, Mapping, Sequence
@@ -39,14 +40,14 @@ from .model import (
     LinearSystem,
     _as_case,
     blade_load_radii,
-    cyclic_flap_lag,
+    cyclic_flap_aero_shares,
 )
 from .mooring import mooring_loads, mooring_table
 from .oc3 import RHO_AIR
 from .record import Record
 from .replay import blade_effective_wind
+from .structure import _CYCLIC, N_DOF
 from .structure import _FLAP as FLAP
-from .structure import N_DOF
 from .validation import check_number
 from .waves import synthesize_waves
 from .wind import TURBSIM_GRID_SPACING, synthesize_rotor_wind
@@ -96,24 +97,16 @@ def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: i
 # ------------------------------------------------------------------------------------------------ kernel
 # scalar parameters of the kernel, packed in one float array ``par``
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
-    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP, P_LAGC, P_LAGS, \
-    P_LAGA = range(28)
-N_PAR = 28
-"""(P_LAGC, P_LAGS: cosine and sine of the blades' flap lag; P_LAGA: the gain of one step of each first-order
-stage at FLAP_LAG_CUTOFF_HZ, dt / (dt + 1 / (2 pi f_c)).)"""
+    P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP, P_PHIT, P_VT, P_WT, \
+    P_VY, P_WY, P_FIP = range(31)
+N_PAR = 31
+"""(P_PHIT: the blade's flap mode at the thrust's centre, ``BladeFlapMode.thrust_shape``; P_VT, P_WT, P_VY, P_WY:
+:func:`surrogates.model.cyclic_flap_aero_shares`; P_FIP: the in-plane force's share of a blade's tip flap velocity,
+its gain-weighted mean of the flap shape.)"""
 I_ACC = N_CONTROLLER_STATE
 """Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
 accelerations of the previous internal step (m/s^2, rad/s^2), which the CM kinematics (``cm_kinematics``) read."""
-I_LAG = N_CONTROLLER_STATE + 3
-"""Slots of ``ctrl`` after those: the blades' tilt and yaw moments low-passed by :data:`FLAP_LAG_CUTOFF_HZ` (two
-cascaded first-order stages each: tilt, tilt, yaw, yaw; N m), the part the cyclic flap lag turns."""
-N_CARRIED = N_CONTROLLER_STATE + 7
-FLAP_LAG_CUTOFF_HZ = 0.3
-"""Corner (Hz) below which the rotor's tilt and yaw moments from the blades' thrust reach the hub turned by the
-flap lag (:func:`surrogates.model.cyclic_flap_lag`). The lag is the blades' quasi-static answer to a load seen
-once per revolution, valid for slow motion (f well below omega_f - Omega ~0.5 Hz, where the regressive flap whirl
-sits); the faster content -- the 1st tower band -- reaches the hub unturned (the whirl's own dynamics are not
-modelled)."""
+N_CARRIED = N_CONTROLLER_STATE + 3
 FIELD_DT = 0.05
 """Time step (s) of the synthesised turbulent field over the rotor disc."""
 N_BLADE_AZIMUTH = 24
@@ -134,6 +127,98 @@ I_ACTION = INPUT_BLOCKS["action"].start
 I_HUB = INPUT_BLOCKS["hub"].start
 I_NL = INPUT_BLOCKS["nonlinear"].start
 I_ROTOR = INPUT_BLOCKS["rotor"].start
+HARMONICS_WIND_SPEED = 12.0
+"""Wind speed (m/s) of OpenFAST's steady run on which :class:`surrogates.model.RotorHarmonics` were measured,
+under the power-law shear :data:`HARMONICS_SHEAR_EXPONENT`."""
+HARMONICS_SHEAR_EXPONENT = 0.2
+
+
+@functools.lru_cache(maxsize=1)
+def _shear_share() -> dict[str, float]:
+    return sampled_shear_harmonics()
+
+
+def sampled_shear_harmonics(wind_speed: float = HARMONICS_WIND_SPEED,
+                            shear_exponent: float = HARMONICS_SHEAR_EXPONENT,
+                            hub_height: float = 90.0) -> dict[str, float]:
+    """The rotor's 3P and 6P loads from its blades sampling the mean power-law shear, as the simulation's
+    rotationally sampled rotor (``rotor_asymmetry``) computes them, in the units of
+    :class:`surrogates.model.RotorHarmonics`.
+
+    OpenFAST's 3P/6P shaft loads, which :class:`~surrogates.model.RotorHarmonics` holds, are those of the tower's
+    shadow *and* the shear; when the blades sample a field that carries the mean shear, the shear's share is in
+    that field already. This is the share (each blade's thrust, torque and in-plane force at its effective wind,
+    linear in the departure from the disc mean; projected on the harmonics' own phases: ``cos 3 psi`` for thrust,
+    torque, tilt and side force, ``sin 3 psi`` for yaw, ``psi = 0`` blade 1 up) that the simulation subtracts
+    from the measured amplitudes, leaving the shadow's: at 12 m/s it is 28 % of the 3P thrust and 59 % of the 3P
+    tilt moment.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Hub-height mean wind speed (m/s).
+    shear_exponent : float
+        Power-law exponent of the mean profile (-).
+    hub_height : float
+        Hub height (m).
+
+    Returns
+    -------
+    dict of str to float
+        ``thrust_3p``, ``thrust_6p``, ``torque_3p``, ``moment_3p``, ``yaw_moment_3p``, ``side_force_3p``: fractions
+        of the operating point's thrust, torque and thrust times radius, signed as the harmonics are (positive:
+        in phase with the measured harmonic).
+    """
+    from .aero import operating_point
+    from .load_cases import operating_case
+    from .oc3 import load_oc3
+
+    wind_speed = check_number("wind_speed", wind_speed, positive=True)
+    shear_exponent = check_number("shear_exponent", shear_exponent, nonneg=True)
+    d = load_oc3()
+    rt = rotor_table()
+    op = operating_point(wind_speed, operating_case(wind_speed).rotor_rpm, d.rotor_inertia)
+    radii = np.linspace(0.0, rt.radius, 5)
+    az = np.arange(FIELD_AZIMUTH) * 2.0 * np.pi / FIELD_AZIMUTH
+    z = radii[:, None] * np.cos(az)[None, :]
+    polar = wind_speed * ((hub_height + z) / hub_height) ** shear_exponent
+    w_ip = inplane_ring_weights(radii, wind_speed)[0]
+    v_t = blade_effective_wind(polar[None], radii, az, N_BLADE_AZIMUTH)[0].astype(float)
+    v_ip = blade_effective_wind(polar[None], radii, az, N_BLADE_AZIMUTH, w_ip)[0].astype(float)
+    disc = float(np.mean(v_t))
+    r_t, r_ty = blade_load_radii(rt.radius)
+    g_ip = float(blade_inplane_sensitivity(round(wind_speed, 2))[1].sum())
+    psi = np.linspace(0.0, 2.0 * np.pi, 360, endpoint=False)
+    az_n = np.arange(N_BLADE_AZIMUTH) * 2.0 * np.pi / N_BLADE_AZIMUTH
+    thrust = np.zeros_like(psi)
+    torque = np.zeros_like(psi)
+    tilt = np.zeros_like(psi)
+    yaw = np.zeros_like(psi)
+    side = np.zeros_like(psi)
+    for b in range(3):
+        psi_b = psi + b * 2.0 * np.pi / 3.0
+        phi = (-psi_b) % (2.0 * np.pi)  # the blade's azimuth from the top towards +y, as the kernel reads it
+        dv = np.interp(phi, az_n, v_t, period=2.0 * np.pi) - disc
+        dv_ip = np.interp(phi, az_n, v_ip, period=2.0 * np.pi) - disc
+        d_t = op.dT_dV / 3.0 * dv
+        thrust += d_t
+        torque += op.dQ_dV / 3.0 * dv
+        tilt += d_t * r_t * np.cos(psi_b)
+        yaw += d_t * r_ty * np.sin(psi_b)
+        side += -g_ip * dv_ip * np.cos(psi_b)
+
+    def coef(x: np.ndarray, fn, n: int) -> float:
+        return float(2.0 * np.mean(x * fn(n * psi)))
+
+    tr = op.thrust * rt.radius
+    return {
+        "thrust_3p": coef(thrust, np.cos, 3) / op.thrust,
+        "thrust_6p": coef(thrust, np.cos, 6) / op.thrust,
+        "torque_3p": coef(torque, np.cos, 3) / op.aero_torque,
+        "moment_3p": -coef(tilt, np.cos, 3) / tr,
+        "yaw_moment_3p": coef(yaw, np.sin, 3) / tr,
+        "side_force_3p": -coef(side, np.cos, 3) / op.thrust,
+    }
 
 
 @numba.njit(cache=True, nogil=True)
@@ -243,22 +328,33 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         # and the disc's own tilt and yaw rates: a point (y, z) of the disc moves downwind at rate_y z - rate_z y,
         # so the blades meet a relative-wind gradient (-rate_y over z, +rate_z over y): the rotor's aerodynamic
         # damping of tilt and yaw (aero_damping)
+        # and the blades' own cyclic flap velocity in the rotating frame at the thrust's centre (the collective's
+        # is in v_hub): (q_t' + Omega q_y) cos psi_b + (q_y' - Omega q_t) sin psi_b
         s_asym = par[P_SASYM]
         s_rot = par[P_SAERO] if par[P_RS] > 0.0 else 0.0
         has_field = s_asym > 0.0 and blade.shape[0] > k and blade[k, 0] == blade[k, 0]  # NaN: azimuth only
         if has_field or s_rot > 0.0:
-            mt = 0.0  # tilt and yaw moments of the wind over the disc
+            it = _CYCLIC[0]
+            iy = _CYCLIC[1]
+            tip_t = x[nd + it] + omega * x[iy]
+            tip_y = x[nd + iy] - omega * x[it]
+            flap_t = par[P_PHIT] * par[P_VT] * tip_t
+            flap_y = par[P_PHIT] * par[P_VY] * tip_y
+            mt = 0.0  # tilt and yaw moments of the blades' thrust
             my = 0.0
-            mt_r = 0.0  # and of the disc's own tilt and yaw rates (aerodynamic damping)
-            my_r = 0.0
+            ft = 0.0  # generalised forces on the cyclic flap modes
+            fyw = 0.0
             fy = 0.0
             fz = 0.0
             for b in range(3):
                 psi_b = psi + b * 2.0 * math.pi / 3.0
                 c_b = math.cos(psi_b)
                 s_b = math.sin(psi_b)
-                dv = -s_rot * (rate_y * par[P_RS] * c_b + rate_z * par[P_RS] * s_b)  # blade at r_s (-sin, cos)
-                d_rate = par[P_DTDU] / 3.0 * dv  # the disc's own tilt/yaw rates' share of the blade's thrust
+                # blade at r_s (-sin, cos)
+                dv_r = -s_rot * (rate_y * par[P_RS] * c_b + rate_z * par[P_RS] * s_b)
+                dv = dv_r - s_rot * (flap_t * c_b + flap_y * s_b)
+                # the in-plane force meets the rates at its own mean radius and the flap at its own mean shape
+                dv_r = dv_r * par[P_RIP] - s_rot * par[P_FIP] * (tip_t * c_b + tip_y * s_b)
                 if has_field:
                     n_az = N_BLADE_AZIMUTH
                     d_az = 2.0 * math.pi / n_az
@@ -269,37 +365,29 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                     wa = fa - int(fa)
                     v_b = (1.0 - wa) * blade[k, i0] + wa * blade[k, i1]
                     v_ip = (1.0 - wa) * blade[k, n_az + i0] + wa * blade[k, n_az + i1]
-                    dv_ip = dv * par[P_RIP] + s_asym * (v_ip - wind)
+                    dv_ip = dv_r + s_asym * (v_ip - wind)
                     dv += s_asym * (v_b - wind)
                 else:
-                    dv_ip = dv * par[P_RIP]
+                    dv_ip = dv_r
                 d_t = par[P_DTDU] / 3.0 * dv
                 d_q = par[P_DQDU] / 3.0 * dv
                 thrust += d_t
                 q_aero += d_q
-                # blade at (y, z) = r (-sin, cos): tilt = z F, yaw = -y F (its own lever: see ROTOR_ASYMMETRY),
-                # carried to the hub by the flap response, which lags the load (cyclic_flap_lag)
-                mt += (d_t - d_rate) * par[P_RT] * c_b
-                my += (d_t - d_rate) * par[P_RTY] * s_b
-                mt_r += d_rate * par[P_RT] * c_b
-                my_r += d_rate * par[P_RTY] * s_b
+                # blade at (y, z) = r (-sin, cos): tilt = z F, yaw = -y F (its own lever: see ROTOR_ASYMMETRY); the
+                # cyclic flap modes take the thrust at the thrust's centre (their response lags it: cyclic_flap_lag)
+                mt += d_t * par[P_RT] * c_b
+                my += d_t * par[P_RTY] * s_b
+                ft += d_t * c_b
+                fyw += d_t * s_b
                 f_ip = par[P_GIP] * dv_ip  # the blade's in-plane force, along the direction of rotation
                 fy += -f_ip * c_b
                 fz += -f_ip * s_b
-            # the blades' flap response peaks the lag later in azimuth (in the direction of rotation, +y to +z):
-            # the moments turn by it about the shaft -- the rate damping wholly (it is slow platform motion, as the
-            # gyroscopic moment it acts with, turned likewise in the linear model), the wind's only below
-            # FLAP_LAG_CUTOFF_HZ
-            c_l, s_l, alpha = par[P_LAGC], par[P_LAGS], par[P_LAGA]
-            ctrl[I_LAG] += alpha * (mt - ctrl[I_LAG])
-            ctrl[I_LAG + 1] += alpha * (ctrl[I_LAG] - ctrl[I_LAG + 1])
-            ctrl[I_LAG + 2] += alpha * (my - ctrl[I_LAG + 2])
-            ctrl[I_LAG + 3] += alpha * (ctrl[I_LAG + 2] - ctrl[I_LAG + 3])
-            st_, sy_ = ctrl[I_LAG + 1], ctrl[I_LAG + 3]
             u[hub0 + 1] += fy
             u[hub0 + 2] += fz
-            u[hub0 + 4] += mt - st_ + c_l * (st_ + mt_r) - s_l * (sy_ + my_r)
-            u[hub0 + 5] += my - sy_ + s_l * (st_ + mt_r) + c_l * (sy_ + my_r)
+            u[hub0 + 4] += mt
+            u[hub0 + 5] += my
+            u[nl0 + it] += par[P_PHIT] * par[P_WT] * ft
+            u[nl0 + iy] += par[P_PHIT] * par[P_WY] * fyw
         q_gen_hss = ctrl[3] + action[1] / par[P_NGEAR]
         q_gen = par[P_NGEAR] * q_gen_hss
         domega = (q_aero - q_gen) / par[P_J]
@@ -330,7 +418,14 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         c1, s1 = math.cos(psi), math.sin(psi)
         c3, s3 = math.cos(3.0 * psi), math.sin(3.0 * psi)
         c6 = math.cos(6.0 * psi)
-        fs = t0 * (harm[4] * c3 + harm[5] * c6 + harm[8] * c1)
+        # where the blades sample a field (with its mean shear), the shear's share of the measured 3P thrust and
+        # tilt is theirs already (sampled_shear_harmonics): the harmonics keep the tower shadow's
+        a3 = harm[4]
+        am = harm[7]
+        if par[P_ROTOR] > 0.0 and par[P_SASYM] > 0.0 and blade.shape[0] > k and blade[k, 0] == blade[k, 0]:
+            a3 -= harm[13]
+            am -= harm[14]
+        fs = t0 * (a3 * c3 + harm[5] * c6 + harm[8] * c1)
         mq = harm[1] * harm[6] * c3
         tr = t0 * harm[2]
         cent = harm[10] * omega * omega
@@ -340,7 +435,7 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         u[rot0 + 3] += fs  # RotThrust carries the harmonic thrust too
         u[hub0 + 1] += cent * s1 - t0 * harm[12] * c3
         u[hub0 + 2] += cent * c1
-        u[hub0 + 4] += tr * (-harm[7] * c3 + harm[9] * c1)
+        u[hub0 + 4] += tr * (-am * c3 + harm[9] * c1)
         u[hub0 + 5] += tr * (harm[11] * s3 + harm[9] * s1)
         # the harmonic amplitudes are OpenFAST's shaft loads, measured behind its flexible blades: they act on the
         # hub, not through the blades' flap mode (which the hub-load block would also drive, by h_v[FLAP])
@@ -510,12 +605,12 @@ class Simulator:
             op.thrust if op else 0.0, op.aero_torque if op else 0.0, st.data.tip_radius,
             self.system.rotor_speed, s3 * h.thrust_3p, s3 * h.thrust_6p, s3 * h.torque_3p, s3 * h.moment_3p,
             s1 * h.thrust_1p, s1 * h.moment_1p, s1 * h.mass_imbalance, s3 * h.yaw_moment_3p, s3 * h.side_force_3p,
+            0.0, 0.0,  # the sampled shear's share of the 3P thrust and tilt (set with the nonlinear rotor)
         ])
         d = st.data
         par = np.zeros(N_PAR)
         par[P_DT] = self.dt_int
-        par[P_LAGC] = 1.0  # no flap lag until the nonlinear rotor's operating point sets it
-        par[P_LAGA] = self.dt_int / (self.dt_int + 1.0 / (2.0 * math.pi * FLAP_LAG_CUTOFF_HZ))
+        par[P_PHIT] = st.data.blade_flap.thrust_shape
         par[P_SMOOR] = float(eff["mooring_nonlinear"])
         par[P_SDRAG] = float(eff["quadratic_drag"])
         par[P_ZF] = zf
@@ -534,13 +629,19 @@ class Simulator:
             par[P_SASYM] = float(eff["rotor_asymmetry"])
             par[P_DTDU], par[P_DQDU] = op.dT_dV, op.dQ_dV
             par[P_RT], par[P_RTY] = blade_load_radii(rt.radius)
+            par[P_VT], par[P_WT], par[P_VY], par[P_WY] = cyclic_flap_aero_shares(rt.radius)
+            # the measured 3P thrust and tilt moment hold the shear's share, which the sampled field carries;
+            # (the yaw and side-force harmonics' phases were fitted to this model's response and the torque
+            # harmonic is the shaft's, behind the drivetrain: none of them is comparable with a sampled share)
+            share = _shear_share()
+            self.harm[13] = s3 * par[P_SASYM] * share["thrust_3p"]
+            self.harm[14] = s3 * par[P_SASYM] * share["moment_3p"]
             r_node, s_node = blade_inplane_sensitivity(round(self.case.wind_speed, 2))
             par[P_GIP] = float(s_node.sum())
             # the disc's tilt and yaw rates load the in-plane force at its own mean radius, not at r_s
             par[P_RS] = BLADE_SAMPLING_RADIUS * rt.radius
             par[P_RIP] = float(np.sum(s_node * r_node) / s_node.sum()) / par[P_RS]
-            lag = cyclic_flap_lag(d.blade_flap, op.dT_dV, self.system.rotor_speed)
-            par[P_LAGC], par[P_LAGS] = math.cos(lag), math.sin(lag)
+            par[P_FIP] = float(np.sum(s_node * d.blade_flap.shape(r_node)) / s_node.sum())
         self.par = par
         self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
         par[P_SKIN] = float(eff["cm_kinematics"])

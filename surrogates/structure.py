@@ -7,6 +7,9 @@ Generalised coordinates ``q`` (SI, small angles in rad)::
     6 tower_fa_1  7 tower_fa_2  8 tower_ss_1  9 tower_ss_2 tower modal amplitudes (m of tower-top deflection)
     10 blade_flap                                          the blades' collective first flap mode (m of tip
                                                            deflection along the shaft; ElastoDyn's BldFl1Sh)
+    11 blade_flap_tilt  12 blade_flap_yaw                 the blades' cyclic flap modes in the fixed frame (m):
+                                                           blade b at azimuth psi_b (0 up) deflects by
+                                                           q_0 + q_tilt cos psi_b + q_yaw sin psi_b
 
 plus the rotor azimuth relative to the nacelle, whose rate is the rotor speed (a cyclic coordinate: no
 stiffness). Tower deflection shapes are ElastoDyn's polynomials (normalised to 1 at the tower top), which
@@ -35,12 +38,13 @@ __all__ = ["DOF_LABELS", "N_DOF", "Structure", "build_structure", "RigidBody"]
 
 DOF_LABELS: tuple[str, ...] = (
     "surge", "sway", "heave", "roll", "pitch", "yaw", "tower_fa_1", "tower_fa_2", "tower_ss_1", "tower_ss_2",
-    "blade_flap",
+    "blade_flap", "blade_flap_tilt", "blade_flap_yaw",
 )
 N_DOF = len(DOF_LABELS)
 _FA = (6, 7)
 _SS = (8, 9)
 _FLAP = 10  # collective first flap mode of the blades: tip deflection along the shaft (m)
+_CYCLIC = (11, 12)  # cyclic flap modes (multi-blade coordinates): with the rotor plane's tilt, then its yaw
 
 
 def _skew(p: np.ndarray) -> np.ndarray:
@@ -295,6 +299,13 @@ def build_structure(n_tower_strips: int = 80, n_fe_elements: int = 40) -> Struct
     mass[_FLAP, _FLAP] += d.n_blades * (flap.mass - flap.first_moment**2 / d.blade_mass)
 
     r_top = _rotation(shapes, z1)
+    # the cyclic flap modes (multi-blade coordinates, three blades; rows times 3/2 so that the mass is symmetric):
+    # a blade's flap moves it along the shaft as the rotor plane's tilt (about +y) and yaw (about +z) do at
+    # cos(psi_b) and sin(psi_b) r, hence the couplings 3/2 int m phi r dr (tools/cyclic_flap_equations.py)
+    for j, axis in zip(_CYCLIC, (1, 2), strict=True):
+        mass[j, j] += 1.5 * flap.mass
+        mass[j, :] += 1.5 * flap.rotary_moment * r_top[axis]
+        mass[:, j] += 1.5 * flap.rotary_moment * r_top[axis]
     n_gear = d.gearbox_ratio
     rotor_inertia_lss = d.rotor_inertia + n_gear**2 * d.generator_inertia
 
@@ -310,6 +321,8 @@ def build_structure(n_tower_strips: int = 80, n_fe_elements: int = 40) -> Struct
     k[3, 3] += -d.platform_mass * GRAVITY * d.platform_cm_z
     k[4, 4] += -d.platform_mass * GRAVITY * d.platform_cm_z
     k[_FLAP, _FLAP] += d.n_blades * flap.stiffness  # parked; the model adds the centrifugal stiffening
+    for j in _CYCLIC:  # parked; the model adds the rotor speed's terms
+        k[j, j] += 1.5 * flap.stiffness
 
     # --- gravity geometric (P-delta) stiffness of everything above SWL: each weight m at height h drops by
     #     (1/2) int_0^h |s(z)|^2 dz when the column tilts and bends, s the slope vector.
@@ -352,6 +365,8 @@ def build_structure(n_tower_strips: int = 80, n_fe_elements: int = 40) -> Struct
         c[i, i] = 2.0 * zeta * np.sqrt(max(k_ii, 0.0) * m_ii)
     # ElastoDyn's blade damping: zeta of the blade's own mode on a rigid hub (parked stiffness)
     c[_FLAP, _FLAP] = 2.0 * flap.damping_ratio * d.n_blades * np.sqrt(flap.stiffness * flap.mass)
+    for j in _CYCLIC:
+        c[j, j] = 1.5 * 2.0 * flap.damping_ratio * np.sqrt(flap.stiffness * flap.mass)
     # the rotor thrust acts on the blades: along the shaft at the hub, and on the flap mode through the mode's
     # value at the thrust's centre -- which is also the share of the flap velocity in the blades' relative wind
     hub_translation = _translation(shapes, z1, apex)

@@ -101,8 +101,11 @@ def test_demo_identification_reports_the_stable_poles_it_draws_and_no_structural
         if kind == "structural":
             assert nearest <= 0.10, (f, rest)
             assert rest.strip("()") in model.modal_analysis(case).labels  # and it names that mode
-        elif kind in ("rotor_band", "unmodelled"):
+        elif kind == "unmodelled":
             assert nearest > 0.10, (f, kind)
+        elif kind == "rotor_band":  # far from every mode, or inside the 3P band that holds no mode of the model
+            in_3p = 0.53 < f < 0.66 and not np.any((model_f > 0.53) & (model_f < 0.66))
+            assert nearest > 0.10 or in_3p, (f, kind)
     # the 3P band of a turbulent rotor (0.55-0.65 Hz here) is no structural mode, and says what it is
     for f, kind, _ in dmd_rows:
         if 0.53 < f < 0.66:

@@ -71,7 +71,9 @@ def test_truth_effects_change_the_records_not_the_kalman_model():
     # the filter keeps the nominal linearisation: its first fore-aft tower mode is the nominal 0.49 Hz, not the
     # truth's sqrt(0.8) x 0.49 = 0.44 Hz
     kf = C._new_sensor("kalman", None, settings)
-    f = np.abs(np.linalg.eigvals(kf.system.A).imag) / (2 * np.pi)
+    lam = np.linalg.eigvals(kf.system.A)
+    lam = lam[-lam.real < 0.2 * np.abs(lam)]  # lightly damped poles (the blades' flap modes are damped 40-70 %)
+    f = np.abs(lam.imag) / (2 * np.pi)
     assert np.min(np.abs(f - _freq(NOMINAL, "tower_fa_1"))) < 0.005
     assert np.min(np.abs(f - np.sqrt(0.8) * _freq(NOMINAL, "tower_fa_1"))) > 0.03
 

@@ -50,22 +50,22 @@ def test_modal_damping_leaves_the_rigid_body_modes_and_damps_the_tower_modes():
     f = np.sqrt(np.maximum(lam, 0)) / (2 * np.pi)
     zeta = np.array([phi @ c @ phi / (2 * np.sqrt(li) * (phi @ m @ phi)) for li, phi in zip(lam, vec.T, strict=True)])
     assert np.all(np.abs(zeta[f < 0.2]) < 1e-12)
-    first = (f > 0.3) & (f < 1.0)  # tower FA/SS 1 and the blades' collective flap mode (0.70 Hz)
-    assert first.sum() == 3
-    flap = DOF_LABELS.index("blade_flap")
+    first = (f > 0.3) & (f < 1.0)  # tower FA/SS 1 and the blades' collective and two cyclic flap modes (0.68-0.72 Hz)
+    assert first.sum() == 5
+    flaps = [DOF_LABELS.index(lab) for lab in ("blade_flap", "blade_flap_tilt", "blade_flap_yaw")]
     # closed form per mode: zeta = phi^T B(omega) phi / (2 omega m) with B straight from the table
     for li, phi in zip(lam[first], vec.T[first], strict=True):
         w = np.sqrt(li)
         expected = phi[:6] @ radiation_damping_matrix(w) @ phi[:6] / (2 * w * (phi @ m @ phi))
         assert phi @ c @ phi / (2 * w * (phi @ m @ phi)) == pytest.approx(expected, rel=1e-9)
-        if np.argmax(np.abs(phi * np.sqrt(np.diag(m)))) != flap:  # the tower modes move the spar
+        if np.argmax(np.abs(phi * np.sqrt(np.diag(m)))) not in flaps:  # the tower modes move the spar
             assert 0.0005 < expected < 0.005  # a few tenths of a per cent of critical
 
 
 def test_parked_tower_decay_damping_over_ten_cycles_matches_openfast():
     """OpenFAST's parked tower fore-aft decay (shared run, packaged copy): over ten cycles its log decrement
     gives 0.93 %; over its first three cycles 1.9 %, inflated by beating with the flexible blades' flap mode
-    (0.7 Hz; the surrogate's collective flap mode beats less). Structural damping alone gives 0.68 %."""
+    (0.7 Hz). Structural damping alone gives 0.68 %."""
     run = load_reference(None, runs=["b_decay_towerFA0p3m"])[0][0]
     ref = decay_analysis(run.record.t, run.record["TTDspFA"], n_cycles=10)
     model = surrogates.FOWTModel(gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS)
