@@ -831,12 +831,10 @@ class Simulator:
                 blade_effective_wind(wd.polar_u, wd.polar_radii, wd.polar_azimuth_rad, N_BLADE_AZIMUTH, w_ip)], axis=1)
             # each azimuth meets the frozen field with its own delay (the disc is tilted: blade_sampling_delay)
             delay = np.tile(self.blade_sampling_delay(), 2)
-            idx = np.clip((t[:, None] - delay[None, :]) / FIELD_DT, 0.0,
-                          on_blade.shape[0] - 1.0)  # held at the field's ends, as np.interp does in a replay
-            i0 = np.minimum(idx.astype(int), on_blade.shape[0] - 2)
-            frac = idx - i0
-            cols = np.arange(on_blade.shape[1])[None, :]
-            blade = ((1.0 - frac) * on_blade[i0, cols] + frac * on_blade[i0 + 1, cols]).astype(np.float32)
+            t_field = np.arange(on_blade.shape[0]) * FIELD_DT
+            blade = np.empty((n, on_blade.shape[1]), dtype=np.float32)
+            for c in range(on_blade.shape[1]):  # held at the field's ends, as in a replay
+                blade[:, c] = np.interp(t - delay[c], t_field, on_blade[:, c])
         psi0 = float(np.random.default_rng(psi_ss).uniform(0.0, 2.0 * np.pi))
         return np.ascontiguousarray(u_ex), vel, psi0, np.ascontiguousarray(blade)
 
