@@ -418,6 +418,13 @@ class FOWTModel:
             f_static = st.gravity_load + h_v * op.thrust + r_s * op.generator_torque_lss
             mean_pitch = float(np.linalg.solve(k, f_static)[4])
             m, k = platform_in_fixed_axes(m, k, st.data.added_mass, mean_pitch, eff["hydro_fixed_axes"])
+        # a turning rotor is free about its shaft: its polar inertia follows the nacelle's roll about the shaft only
+        # through the generator (rotor_free_inertia); parked, it is locked to the nacelle (as in BModes)
+        spin_coupling = free_spin = 0.0
+        if op is not None:
+            spin_coupling, free_spin = rotor_free_inertia(st)
+            m = m - free_spin * np.outer(r_s, r_s)
+        spin_share = 1.0 - spin_coupling / st.rotor_inertia_lss if op is not None else 0.0
         # the spar's WAMIT radiation damping at the tower modes' frequencies (surrogates.radiation)
         c += modal_radiation_damping(m, k)
         j_hub, r_tt = st.hub_translation, st.tower_top_rotation
@@ -449,6 +456,9 @@ class FOWTModel:
         f_u = np.zeros((N_DOF, n_u))
         f_x += np.outer(h_v, t_x) + np.outer(r_s, qg_x)
         f_u += np.outer(h_v, t_u) + np.outer(r_s, qg_u)
+        if linear_rotor:  # the free rotor's share of its torque imbalance on the nacelle: (J - c) / J (Qa - Qg)
+            f_x += spin_share * np.outer(r_s, qa_x - qg_x)
+            f_u += spin_share * np.outer(r_s, qa_u - qg_u)
         f_u[:, 0] += st.gravity_load + h_v * t0 + r_s * qg0
         # the mean thrust follows the rotor axis as the tower top pitches and yaws (a rotation theta about axis a
         # turns e_s by theta e_a x e_s): pitch gives the platform's set-down and heave-pitch coupling under thrust,
@@ -476,8 +486,8 @@ class FOWTModel:
         flap = st.data.blade_flap
         v_t, w_t, v_y, w_y = cyclic_flap_aero_shares(st.data.tip_radius)
         if op is not None:
-            r_s = BLADE_SAMPLING_RADIUS * st.data.tip_radius
-            cyc_gain[:] = 1.5 * op.dT_dV / 3.0 * flap.thrust_shape * r_s * np.array([w_t, w_y])
+            r_sample = BLADE_SAMPLING_RADIUS * st.data.tip_radius
+            cyc_gain[:] = 1.5 * op.dT_dV / 3.0 * flap.thrust_shape * r_sample * np.array([w_t, w_y])
             f_u[_CYCLIC[1], sh.start] += -s_shear * cyc_gain[1]
             f_u[_CYCLIC[0], sh.start + 1] += s_shear * cyc_gain[0]
         # the rotor's aerodynamic damping of tilt and yaw: a disc turning at (pitch rate, yaw rate) meets the
@@ -529,8 +539,10 @@ class FOWTModel:
         b[N_DOF:2 * N_DOF] = minv @ f_u
         if linear_rotor:
             j = st.rotor_inertia_lss
-            a[2 * N_DOF] = (qa_x - qg_x) / j
-            b[2 * N_DOF] = (qa_u - qg_u) / j
+            # the rotor speed relative to the nacelle (OpenFAST's RotSpeed) also answers the nacelle's roll
+            # about the shaft: J Omega' + c (r_s . q'') = Qa - Qg
+            a[2 * N_DOF] = (qa_x - qg_x) / j - spin_coupling / j * (r_s @ a[N_DOF:2 * N_DOF])
+            b[2 * N_DOF] = (qa_u - qg_u) / j - spin_coupling / j * (r_s @ b[N_DOF:2 * N_DOF])
             a[2 * N_DOF + 1, 2 * N_DOF] = 1.0
 
         # the Morison drag's equivalent linearisation about this load case's stationary response (sea state and
@@ -610,6 +622,13 @@ class FOWTModel:
             mom_x += np.outer(e_s, qg_x)
             mom_u += np.outer(e_s, qg_u)
             mom_u[:, 0] += e_s * qg0
+            # the free rotor: its polar inertia follows the nacelle's roll only in part (rotor_free_inertia), and
+            # (linear rotor) the nacelle takes (J - c) / J of its torque imbalance besides the generator's torque
+            mom_x += free_spin * np.outer(e_s, r_s @ qdd_x)
+            mom_u += free_spin * np.outer(e_s, r_s @ qdd_u)
+            if linear_rotor:
+                mom_x += spin_share * np.outer(e_s, qa_x - qg_x)
+                mom_u += spin_share * np.outer(e_s, qa_u - qg_u)
             suffix = ("MLyt", "MLxt") if prefix.startswith("TwHt") else ("Myt", "Mxt")
             rows_x[prefix + suffix[0]], rows_u[prefix + suffix[0]] = mom_x[1] / 1e3, mom_u[1] / 1e3
             rows_x[prefix + suffix[1]], rows_u[prefix + suffix[1]] = mom_x[0] / 1e3, mom_u[0] / 1e3
@@ -877,6 +896,23 @@ def cyclic_flap_lag(flap: BladeFlapMode, wind_speed_gain: float, rotor_speed: fl
     zeta = c / (2.0 * np.sqrt(k * flap.mass))
     r = omega / omega_f
     return float(np.arctan2(2.0 * zeta * r, 1.0 - r * r))
+
+
+def rotor_free_inertia(st: Structure) -> tuple[float, float]:
+    """The turning rotor's coupling with the nacelle's roll about the shaft (kg m^2): ``(c, c^2 / J)``.
+
+    With the rotor's azimuth ``phi`` relative to the nacelle a coordinate of its own and ``w`` the nacelle's rotation
+    rate about the shaft, the kinetic energy is ``J_r (phi' + w)^2 / 2 + J_g (N phi' + w)^2 / 2``: the structure's
+    roll inertia holds ``J_r + J_g`` (the rotor locked to the nacelle, as for a parked rotor and in BModes), the rotor
+    ``J = J_r + N^2 J_g`` (``Structure.rotor_inertia_lss``), and they couple by ``c = J_r + N J_g``. Eliminating
+    ``phi''`` leaves the nacelle with ``c^2 / J`` (3.4e7 of the rotor's 3.8e7 kg m^2) less roll inertia, and with
+    ``(J - c) / J`` of the rotor's torque imbalance (``Qa - Qg``; the generator's inertia reaction, 12 %). OpenFAST's
+    operating side-to-side tower mode shows it: its spectra peak at 0.500 Hz, the locked rotor's mode is at 0.481 Hz,
+    the free rotor's at 0.497 Hz.
+    """
+    d = st.data
+    c = d.rotor_inertia + d.gearbox_ratio * d.generator_inertia
+    return c, c * c / st.rotor_inertia_lss
 
 
 def _cyclic_flap_terms(st: Structure, omega: float, s_gyro: float, k: np.ndarray, c: np.ndarray) -> None:

@@ -41,6 +41,7 @@ from .model import (
     _as_case,
     blade_load_radii,
     cyclic_flap_aero_shares,
+    rotor_free_inertia,
 )
 from .mooring import mooring_loads, mooring_table
 from .oc3 import RHO_AIR
@@ -98,11 +99,12 @@ def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: i
 # scalar parameters of the kernel, packed in one float array ``par``
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
     P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP, P_PHIT, P_VT, P_WT, \
-    P_VY, P_WY, P_FIP = range(31)
-N_PAR = 31
+    P_VY, P_WY, P_FIP, P_SPINC = range(32)
+N_PAR = 32
 """(P_PHIT: the blade's flap mode at the thrust's centre, ``BladeFlapMode.thrust_shape``; P_VT, P_WT, P_VY, P_WY:
 :func:`surrogates.model.cyclic_flap_aero_shares`; P_FIP: the in-plane force's share of a blade's tip flap velocity,
-its gain-weighted mean of the flap shape.)"""
+its gain-weighted mean of the flap shape; P_SPINC: ``c / J`` of :func:`surrogates.model.rotor_free_inertia`, how the
+rotor speed relative to the nacelle answers the nacelle's roll about the shaft.)"""
 I_ACC = N_CONTROLLER_STATE
 """Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
 accelerations of the previous internal step (m/s^2, rad/s^2), which the CM kinematics (``cm_kinematics``) read."""
@@ -495,10 +497,15 @@ def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, v
         psi += (harm[3] + x[2 * N_DOF]) * dt
         for i in range(3):  # heave, roll, pitch accelerations over the step, for the next step's CM kinematics
             ctrl[I_ACC + i] = (xn[N_DOF + 2 + i] - x[N_DOF + 2 + i]) / dt
+        droll = 0.0  # the nacelle's roll rate about the shaft: its change over the step
+        if rotor:
+            for i in range(N_DOF):
+                droll += r_pitch[2 * N_DOF + i] * (xn[N_DOF + i] - x[N_DOF + i])
         for r in range(n_x):
             x[r] = xn[r]
         if rotor:
-            x[2 * N_DOF] += domega * dt
+            # the rotor speed relative to the nacelle: J Omega' + c (r_s . q'') = Qa - Qg (rotor_free_inertia)
+            x[2 * N_DOF] += domega * dt - par[P_SPINC] * droll
             discon_step(discon, ctrl, par[P_NGEAR] * (par[P_OMEGA0] + x[2 * N_DOF]), dt)
     return psi
 
@@ -593,8 +600,9 @@ class Simulator:
         self.moor_g0, self.moor_jac = self._mooring_linearisation(zf)
         self.e_s = np.ascontiguousarray(st.shaft_axis, dtype=float)
         self.h_v = np.ascontiguousarray(st.shaft_axis @ st.hub_translation, dtype=float)
-        self.r_pitch = np.ascontiguousarray(np.concatenate([st.tower_top_rotation[1], st.tower_top_rotation[2]]),
-                                            dtype=float)  # tower-top pitch row, then yaw row
+        self.r_pitch = np.ascontiguousarray(np.concatenate([st.tower_top_rotation[1], st.tower_top_rotation[2],
+                                                            st.shaft_axis @ st.tower_top_rotation]),
+                                            dtype=float)  # tower-top pitch row, yaw row, then about the shaft
         rt = rotor_table()
         self.rotor_grids = (np.ascontiguousarray(rt.tsr, dtype=float), np.ascontiguousarray(rt.pitch_rad, dtype=float),
                             np.ascontiguousarray(rt.ct, dtype=float), np.ascontiguousarray(rt.cq, dtype=float))
@@ -642,6 +650,7 @@ class Simulator:
             par[P_RS] = BLADE_SAMPLING_RADIUS * rt.radius
             par[P_RIP] = float(np.sum(s_node * r_node) / s_node.sum()) / par[P_RS]
             par[P_FIP] = float(np.sum(s_node * d.blade_flap.shape(r_node)) / s_node.sum())
+            par[P_SPINC] = rotor_free_inertia(st)[0] / st.rotor_inertia_lss
         self.par = par
         self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
         par[P_SKIN] = float(eff["cm_kinematics"])

@@ -62,7 +62,8 @@ def test_kalman_beats_hold_on_the_hidden_channels(small):
     # the training mean of a hidden channel explains none of its variance in the test record
     for sc in ("A", "B"):
         assert by_key(small, sc, "hold")["median_r2"] < 0.1
-        assert abs(by_key(small, sc, "hold")["median_r2_band"]) < 1e-3  # band-passed constant = 0 -> R2 = 0
+        # band-passed constant = 0 -> R2 = -(the band-passed truth's mean)^2 / its variance, ~0
+        assert abs(by_key(small, sc, "hold")["median_r2_band"]) < 5e-3
 
 
 def training_mean() -> np.ndarray:

@@ -311,7 +311,7 @@ def test_steady_wind_3p_lines_fore_aft_are_openfasts():
     """OpenFAST's steady 12 m/s sheared run (packaged copy, 300 s at 10 Hz): the 3P lines of the fore-aft tower
     channels and the thrust. The measured 3P harmonics hold tower shadow and shear; the blades also sample the
     field's mean shear, whose share the simulation takes off the harmonics (``sampled_shear_harmonics``). Counted
-    twice, the lines came out 2.3-3.1x OpenFAST's; now 0.8-1.0x over two seeds. (The side-to-side lines, 0.6-0.7x,
+    twice, the lines came out 2.3-3.1x OpenFAST's; now 0.8-1.0x over two seeds. (The side-to-side lines, 0.7x,
     follow the yaw and side-force harmonics, whose phases were fitted, and are not checked here.)"""
     from fowt_env.validation import load_reference, surrogate_case
 
