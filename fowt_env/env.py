@@ -404,7 +404,7 @@ class SparEnv(gym.Env):
     # ------------------------------------------------------------------------------------------ extras
     @property
     def state(self) -> np.ndarray:
-        """The surrogate's state vector (24,: see surrogates.model.STATE_NAMES), for model-based studies."""
+        """The surrogate's state vector (28,: see surrogates.model.STATE_NAMES), for model-based studies."""
         return self._sim.state
 
     @property
