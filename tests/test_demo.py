@@ -142,3 +142,10 @@ def test_label_against_model_keeps_what_the_model_has_and_names_the_rest():
     # without a rotor speed, the same line is only known not to be a model mode
     again = label_against_model([{"frequency_hz": 0.60, "kind": "structural"}], model_modes, 0.1, None)
     assert again[0]["kind"] == "unmodelled"
+    # a mode within 10 % of the band's foot (0.53 Hz against 0.57-0.63 Hz): a line inside the band is the band's,
+    # one between the mode and the band the mode's, and a mode inside the band keeps the lines near it
+    near = [("tower_fa_1", 0.53)]
+    rows = label_against_model([{"frequency_hz": f, "kind": "structural"} for f in (0.58, 0.55)], near, 0.1, bands)
+    assert [r["kind"] for r in rows] == ["rotor_band", "structural"] and rows[0]["rotor_order"] == 3
+    inside = label_against_model([{"frequency_hz": 0.59, "kind": "structural"}], [("blade", 0.60)], 0.1, bands)
+    assert inside[0]["kind"] == "structural" and inside[0]["model_mode"] == "blade"
