@@ -890,8 +890,7 @@ def cyclic_flap_lag(flap: BladeFlapMode, wind_speed_gain: float, rotor_speed: fl
     if not np.isfinite(omega) or omega <= 0.0:
         return 0.0
     k = flap.stiffness + omega**2 * flap.centrifugal
-    c = (2.0 * flap.damping_ratio * np.sqrt(flap.stiffness * flap.mass)
-         + max(float(wind_speed_gain), 0.0) / 3.0 * flap.thrust_shape**2)
+    c = flap.structural_damping + max(float(wind_speed_gain), 0.0) / 3.0 * flap.thrust_shape**2
     omega_f = np.sqrt(k / flap.mass)
     zeta = c / (2.0 * np.sqrt(k * flap.mass))
     r = omega / omega_f
@@ -930,7 +929,7 @@ def _cyclic_flap_terms(st: Structure, omega: float, s_gyro: float, k: np.ndarray
         return
     flap = st.data.blade_flap
     it, iy = _CYCLIC
-    c_f = 2.0 * flap.damping_ratio * np.sqrt(flap.stiffness * flap.mass)
+    c_f = flap.structural_damping
     for j in _CYCLIC:
         k[j, j] += 1.5 * (flap.centrifugal - flap.mass) * omega**2
     k[it, iy] += 1.5 * c_f * omega

@@ -90,12 +90,24 @@ class BladeFlapMode:
         """The mode shape (tip = 1) at radii from the rotor's centre (m); 0 inboard of the root."""
         r0, r1 = self.span
         x = np.clip((np.asarray(radius, dtype=float) - r0) / (r1 - r0), 0.0, 1.0)
-        return sum(c * x ** (k + 2) for k, c in enumerate(self.shape_coefficients))
+        return _flap_shape(np.asarray(self.shape_coefficients, dtype=float), x)
+
+    @property
+    def structural_damping(self) -> float:
+        """One blade's structural damping coefficient on the mode (N s/m): ElastoDyn's ``BldFlDmp``, the damping
+        ratio of the blade's own mode on a rigid hub at its parked stiffness, ``2 zeta sqrt(k m)``."""
+        return 2.0 * self.damping_ratio * float(np.sqrt(self.stiffness * self.mass))
 
     def frequency_hz(self, rotor_rpm: float) -> float:
         """Natural frequency of the blade's flap mode on a rigid hub (Hz) at a rotor speed (rpm)."""
         omega = rotor_rpm * np.pi / 30.0
         return float(np.sqrt((self.stiffness + omega**2 * self.centrifugal) / self.mass) / (2.0 * np.pi))
+
+
+def _flap_shape(coeffs: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """ElastoDyn's flap mode shape ``sum_k c_k x^(k+2)`` (``BldFl1Sh(2..6)``) at span fractions ``x``."""
+    powers = np.arange(2, 2 + coeffs.size)
+    return (coeffs * np.asarray(x, dtype=float)[..., None] ** powers).sum(axis=-1)
 
 
 def _blade_flap_mode(bl: dict[str, str], blade: np.ndarray, hub_r: float, tip: float) -> BladeFlapMode:
@@ -108,7 +120,7 @@ def _blade_flap_mode(bl: dict[str, str], blade: np.ndarray, hub_r: float, tip: f
     r = hub_r + x * length
     m = np.interp(x, blade[:, 0], blade[:, 2]) * _number(bl, "AdjBlMs")
     ei = np.interp(x, blade[:, 0], blade[:, 3]) * _number(bl, "AdjFlSt") * _number(bl, "FlStTunr(1)")
-    phi = (coeffs[None, :] * x[:, None] ** powers).sum(axis=1)
+    phi = _flap_shape(coeffs, x)
     d1 = (coeffs * powers * x[:, None] ** (powers - 1)).sum(axis=1) / length
     d2 = (coeffs * powers * (powers - 1) * x[:, None] ** (powers - 2)).sum(axis=1) / length**2
     tension = np.trapezoid(m * r, r) - cumulative_trapezoid(m * r, r, initial=0.0)  # N(r) = int_r^R m s ds

@@ -364,9 +364,9 @@ def build_structure(n_tower_strips: int = 80, n_fe_elements: int = 40) -> Struct
         k_ii = k[i, i]
         c[i, i] = 2.0 * zeta * np.sqrt(max(k_ii, 0.0) * m_ii)
     # ElastoDyn's blade damping: zeta of the blade's own mode on a rigid hub (parked stiffness)
-    c[_FLAP, _FLAP] = 2.0 * flap.damping_ratio * d.n_blades * np.sqrt(flap.stiffness * flap.mass)
+    c[_FLAP, _FLAP] = d.n_blades * flap.structural_damping
     for j in _CYCLIC:
-        c[j, j] = 1.5 * 2.0 * flap.damping_ratio * np.sqrt(flap.stiffness * flap.mass)
+        c[j, j] = 1.5 * flap.structural_damping
     # the rotor thrust acts on the blades: along the shaft at the hub, and on the flap mode through the mode's
     # value at the thrust's centre -- which is also the share of the flap velocity in the blades' relative wind
     hub_translation = _translation(shapes, z1, apex)

@@ -9,6 +9,8 @@ References
   tower bending frequencies of the same structure with a rigid RNA.
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -75,7 +77,7 @@ def test_tower_bending_modes_match_pybmodes_fe(pybmodes_frequencies):
         assert np.min(np.abs(elastic - f) / elastic) < 0.06, (f, elastic)
 
 
-RUNS = __import__("pathlib").Path(__file__).resolve().parents[1] / "../shared/reference/openfast/runs"
+RUNS = Path(__file__).resolve().parents[1] / "../shared/reference/openfast/runs"
 
 
 @pytest.mark.skipif(not RUNS.is_dir(), reason="needs ../shared/reference/openfast (full OpenFAST outputs)")
