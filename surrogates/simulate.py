@@ -81,18 +81,41 @@ _INITIAL_CHANNELS = (*_PLATFORM_DOF, *_PLATFORM_RATE, "TTDspFA", "TTDspSS", "Rot
 def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: int) -> None:
     """Turn the model's platform roll and yaw (deg, in place in ``y`` of shape (n, channels)) into ElastoDyn's.
 
-    The model's roll and yaw are small rotations about the platform's own axes, which pitch with it: a slender
-    spar yaws about its long axis. ElastoDyn's ``PtfmRoll/Pitch/Yaw`` are instead the components, in the fixed
-    axes, of one rotation (``SmllRotTrans``: the orthonormal matrix closest to ``I + [theta]x``, i.e. a rotation
-    by ``atan|theta|`` about ``theta``). Composing the pitch ``p`` with a body yaw ``y`` (Baker-Campbell-Hausdorff
-    to second order, ``log(e^A e^B) = A + B + [A, B]/2``) gives ElastoDyn's roll ``r + p y / 2`` and yaw
-    ``y - p r / 2``: at OpenFAST's 4 deg mean pitch at rated wind, 3.6 % of the yaw appears as roll, the part of
-    OpenFAST's roll that is coherent with its yaw in the wave band (|H| 0.045 deg/deg at 0.1-0.25 Hz, 12 m/s).
+    The model's roll ``r`` and yaw ``y`` are small rotations about the platform's own axes, which pitch with it: a
+    slender spar yaws about its long axis. ElastoDyn (OpenFAST v5, ``SetCoordSy``) instead describes the platform
+    by Euler angles in the order yaw about the vertical, pitch about the yawed lateral axis, roll about the pitched
+    longitudinal axis (``EulerConstructZYX``): ``R = R_z(PtfmYaw) R_y(PtfmPitch) R_x(PtfmRoll)``. Equating it with
+    ``R_y(p) (I + [r, 0, y]x)`` to first order in ``r`` and ``y`` (the pitch ``p`` finite) gives
+
+        PtfmRoll = r + y tan(p),    PtfmPitch = p,    PtfmYaw = y / cos(p):
+
+    at OpenFAST's 4 deg mean pitch at rated wind, 7 % of the platform's own yaw appears as roll. OpenFAST's
+    records show exactly that: their roll over yaw in 0.065-0.11 Hz, where the yaw mode drives both (coherence
+    0.8-0.95), is 0.078-0.092 deg/deg at 12 m/s (mean pitch 4.1 deg, sin 0.072) and 0.044-0.048 at 18 m/s
+    (2.8 deg, sin 0.049). (ElastoDyn before v5 used the rotation vector of ``SmllRotTrans``, which would show
+    ``p y / 2``.) :func:`body_platform_angles` is the inverse.
     """
     p = np.deg2rad(y[:, i_pitch])
-    r = y[:, i_roll].copy()
-    y[:, i_roll] += 0.5 * p * y[:, i_yaw]
-    y[:, i_yaw] -= 0.5 * p * r
+    y[:, i_roll] += np.tan(p) * y[:, i_yaw]
+    y[:, i_yaw] /= np.cos(p)
+
+
+def body_platform_angles(roll: float, pitch: float, yaw: float) -> tuple[float, float]:
+    """The model's body-axes roll and yaw for ElastoDyn's platform Euler angles (the inverse of
+    :func:`elastodyn_platform_angles`).
+
+    Parameters
+    ----------
+    roll, pitch, yaw : float
+        ElastoDyn's ``PtfmRoll``, ``PtfmPitch``, ``PtfmYaw`` (rad).
+
+    Returns
+    -------
+    (float, float)
+        Roll and yaw about the platform's own (pitched) axes (rad).
+    """
+    y = yaw * math.cos(pitch)
+    return roll - math.tan(pitch) * y, y
 
 
 # ------------------------------------------------------------------------------------------------ kernel
@@ -760,6 +783,19 @@ class Simulator:
                     raise ValueError(f"initial: {name} needs an operating load case (the rotor is parked)")
             else:
                 raise ValueError(f"initial: unknown channel {name!r}; known: {sorted(_INITIAL_CHANNELS)}")
+        # ElastoDyn's roll and yaw are Euler angles and its rotational velocities fixed-axes components; the
+        # model's roll and yaw turn about the platform's own, pitched axes (elastodyn_platform_angles)
+        pitch = float(x[4])
+        if "PtfmRoll" in initial or "PtfmYaw" in initial:
+            roll_ed = np.deg2rad(float(initial["PtfmRoll"])) if "PtfmRoll" in initial else x[3] + math.tan(pitch) * x[5]
+            yaw_ed = np.deg2rad(float(initial["PtfmYaw"])) if "PtfmYaw" in initial else x[5] / math.cos(pitch)
+            x[3], x[5] = body_platform_angles(float(roll_ed), pitch, float(yaw_ed))
+        if "PtfmRVxi" in initial or "PtfmRVzi" in initial:
+            c, s = math.cos(pitch), math.sin(pitch)
+            wr, wy = x[N_DOF + 3], x[N_DOF + 5]
+            wx = np.deg2rad(float(initial["PtfmRVxi"])) if "PtfmRVxi" in initial else c * wr + s * wy
+            wz = np.deg2rad(float(initial["PtfmRVzi"])) if "PtfmRVzi" in initial else -s * wr + c * wy
+            x[N_DOF + 3], x[N_DOF + 5] = c * wx - s * wz, s * wx + c * wz
         if self.system.op and ("BldPitch1" in initial or "GenTq" in initial):
             pitch = np.deg2rad(float(initial["BldPitch1"])) if "BldPitch1" in initial else float(ctrl[2])
             torque = 1e3 * float(initial["GenTq"]) if "GenTq" in initial else None

@@ -1,6 +1,6 @@
 """Kinematics of the rotor axis and of the platform angles against closed forms: the thrust follows the
 rotor axis when the tower top yaws (a side force ``T sin(psi)``), and the platform roll/yaw are reported as
-ElastoDyn's rotation components (checked against scipy's exact rotation algebra)."""
+ElastoDyn's Euler angles (checked against scipy's exact rotation algebra)."""
 
 from __future__ import annotations
 
@@ -9,35 +9,47 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import surrogates
-from surrogates.simulate import I_HUB, I_ROTOR, Simulator, elastodyn_platform_angles
+from surrogates.simulate import I_HUB, I_ROTOR, Simulator, body_platform_angles, elastodyn_platform_angles
 
 
 def _elastodyn_angles(rot: Rotation) -> np.ndarray:
-    """ElastoDyn's (theta1, theta2, theta3) of an orientation: SmllRotTrans is the orthonormal matrix closest to
-    ``I + [theta]x``, i.e. the rotation by ``atan|theta|`` about ``theta`` (so ``theta = axis tan(angle)``)."""
-    phi = rot.as_rotvec()
-    angle = np.linalg.norm(phi)
-    return phi if angle == 0 else phi / angle * np.tan(angle)
+    """ElastoDyn's (PtfmRoll, PtfmPitch, PtfmYaw) of an orientation (rad). OpenFAST v5's ``SetCoordSy`` turns the
+    platform by its yaw about the vertical, then its pitch about the yawed lateral axis, then its roll about the
+    pitched longitudinal axis (``EulerConstructZYX``): intrinsic Z-Y-X Euler angles."""
+    yaw, pitch, roll = rot.as_euler("ZYX")
+    return np.array([roll, pitch, yaw])
 
 
 @pytest.mark.parametrize("pitch_deg, roll_deg, yaw_deg", [(4.1, 0.0, 0.5), (4.1, 0.2, -0.8), (-3.0, -0.3, 1.2),
                                                           (8.0, 0.1, 0.3)])
-def test_platform_angles_match_elastodyn_rotation_components(pitch_deg, roll_deg, yaw_deg):
+def test_platform_angles_match_elastodyn_euler_angles(pitch_deg, roll_deg, yaw_deg):
     # the model's roll and yaw turn the platform about its own (pitched) axes
     rot = Rotation.from_euler("y", pitch_deg, degrees=True) * Rotation.from_rotvec(
         np.deg2rad([roll_deg, 0.0, yaw_deg]))
     truth = np.rad2deg(_elastodyn_angles(rot))
     y = np.array([[roll_deg, pitch_deg, yaw_deg]])
     elastodyn_platform_angles(y, 0, 1, 2)
-    # second-order composition: the residual is third order (the pitch-yaw product p y / 2 times ~p / 6, and
-    # ElastoDyn's tan scaling of each angle, ~p^2 / 3)
-    p = abs(np.deg2rad(pitch_deg))
-    tol = (p / 6 + p * p / 3 + 0.01) * max(abs(yaw_deg), abs(roll_deg)) + 1e-9
+    # first order in the small roll and yaw: the residual is second order in them (~ angle^2 in rad)
+    small = np.deg2rad(max(abs(yaw_deg), abs(roll_deg)))
+    tol = np.rad2deg(2.0 * small * small) + 1e-9
     assert abs(y[0, 0] - truth[0]) < tol
+    assert abs(y[0, 1] - truth[1]) < tol
     assert abs(y[0, 2] - truth[2]) < tol
-    # without the map the roll error would be the whole coupling p y / 2
+    # without the map the roll error would be the whole coupling y tan(p)
     if yaw_deg and pitch_deg:
         assert abs(roll_deg - truth[0]) > 5 * abs(y[0, 0] - truth[0])
+    # and the inverse map returns the body angles
+    r, yw = body_platform_angles(*np.deg2rad(y[0]))
+    assert np.rad2deg([r, yw]) == pytest.approx([roll_deg, yaw_deg], abs=1e-9)
+
+
+def test_initial_platform_angles_are_elastodyns():
+    # a free decay started from ElastoDyn's roll and yaw at a pitch reports them back at the release
+    model = surrogates.FOWTModel()
+    initial = {"PtfmPitch": 5.0, "PtfmRoll": 0.4, "PtfmYaw": 2.0}
+    rec = surrogates.simulate(model, None, 1.0, 0.0125, transient=0.0, noise=False, initial=initial)
+    for name, value in initial.items():
+        assert rec[name][0] == pytest.approx(value, abs=1e-6)
 
 
 def test_thrust_turns_sideways_with_the_tower_top_yaw():
