@@ -235,6 +235,9 @@ class LinearSystem:
     effects: dict[str, float]
     structure: Structure = field(repr=False)
     drag: DragStrips | None = field(default=None, repr=False)
+    mean_moments: dict[str, tuple[np.ndarray, np.ndarray]] | None = field(default=None, repr=False)
+    """Per tower section (``"TwrBs"``, ``"TwHt1"`` ...): its mean rotation (rad) and mean bending-moment vector
+    (N m, fixed axes) under the operating point's mean loads (:func:`local_moment_rows`)."""
     """The Morison drag strips with the equivalent linearisation held in ``A`` (and in the wave forcing)."""
 
     def equilibrium(self, nonlinear_force=None, tol: float = 1e-10) -> np.ndarray:
@@ -414,9 +417,13 @@ class FOWTModel:
         r_s = e_s @ st.tower_top_rotation  # generalised force of a moment about the shaft at the tower top
         # HydroDyn's added mass and the platform's restoring act in the fixed axes: at the mean pitch that the
         # thrust holds, the spar's own yaw is also a fixed-axes roll (surrogates.hydro_axes)
+        f_static = st.gravity_load + (h_v * op.thrust + r_s * op.generator_torque_lss if op is not None else 0.0)
+        mean_pitch = float(np.linalg.solve(k, f_static)[4])
+        # the weights under that pitch: the platform's own yaw y turns the tower's lateral axis by y sin(pitch) out
+        # of the horizontal, so a lateral deflection d (platform axes) raises a mass m by d y sin(pitch) (ElastoDyn's
+        # exact kinematics; the p_delta family of geometric stiffness)
+        k += s_pd * tilted_yaw_gravity_stiffness(st, mean_pitch)
         if op is not None and eff["hydro_fixed_axes"] > 0:
-            f_static = st.gravity_load + h_v * op.thrust + r_s * op.generator_torque_lss
-            mean_pitch = float(np.linalg.solve(k, f_static)[4])
             m, k = platform_in_fixed_axes(m, k, st.data.added_mass, mean_pitch, eff["hydro_fixed_axes"])
         # a turning rotor is free about its shaft: its polar inertia follows the nacelle's roll about the shaft only
         # through the generator (rotor_free_inertia); parked, it is locked to the nacelle (as in BModes)
@@ -464,8 +471,17 @@ class FOWTModel:
         # turns e_s by theta e_a x e_s): pitch gives the platform's set-down and heave-pitch coupling under thrust,
         # yaw a side force T psi that drives sway and roll (the simulation's rotor does the same; roll, which
         # turns only the shaft's tilt component, is left out there and here)
+        # The tower's and the blades' modes deflect in the axes of the platform and of the rotor, which turn with
+        # the platform as the thrust does: for them (as in ElastoDyn) only the tower top's rotation relative to the
+        # platform turns the thrust. With the nonlinear rotor the simulation turns it by the top's whole rotation
+        # (through the hub loads); the mean thrust's share of that on these modes is taken back here.
         for axis in (1, 2):
-            f_x[:, :N_DOF] += t0 * np.outer(j_hub.T @ np.cross(np.eye(3)[axis], e_s), r_tt[axis])
+            follow = np.outer(j_hub.T @ np.cross(np.eye(3)[axis], e_s), r_tt[axis])
+            if linear_rotor:
+                follow[6:, 3:6] = 0.0
+                f_x[:, :N_DOF] += t0 * follow
+            elif op is not None and nonlinear_rotor:
+                f_x[6:, 3:6] -= op.thrust * follow[6:, 3:6]
         f_u[:6, INPUT_BLOCKS["wave"]] += np.eye(6)
         hub = INPUT_BLOCKS["hub"]
         f_u[:, hub.start:hub.start + 3] += j_hub.T
@@ -557,6 +573,14 @@ class FOWTModel:
 
         # ------------------------------------------------------------------ outputs (55 channels)
         qdd_x, qdd_u = a[N_DOF:2 * N_DOF], b[N_DOF:2 * N_DOF]
+        # ElastoDyn reports a tower moment in the axes of its section, which turn with the mean moment in them
+        # (local_moment_rows): the sections' mean rotations and moments under the mean loads, from the static
+        # deflection of the model whose rotor loads are linear (with the nonlinear rotor the mean loads come
+        # through the inputs)
+        mean_moments: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        reference = self._system(lc, nonlinear_rotor=False).mean_moments if (op is not None and nonlinear_rotor) \
+            else None
+        q_static = np.linalg.solve(k - f_x[:, :N_DOF], f_u[:, 0]) if reference is None else None
         thrust_x, thrust_u = t_x, t_u.copy()
         thrust_u[0] += t0
         rows_x: dict[str, np.ndarray] = {}
@@ -612,6 +636,9 @@ class FOWTModel:
             mom_x[:, :N_DOF] += -_skew(e_s * t_ref) @ (st.hub_translation - t_h)
             mom_u[:, hub.start:hub.start + 3] += lever_hub
             mom_u[:, hub.start + 3:hub.stop] += np.eye(3)
+            if linear_rotor:  # the mean thrust turned with the tower top (the nonlinear rotor's hub loads carry it)
+                for axis in (1, 2):
+                    mom_x[:, :N_DOF] += t0 * np.outer(lever_hub @ np.cross(np.eye(3)[axis], e_s), r_tt[axis])
             for col, (force, moment) in zip(range(sh.start, sh.stop), shear_loads, strict=True):
                 mom_u[:, col] += lever_hub @ force + moment
             for rows, (force, moment) in zip(rate_rows, motion_loads, strict=True):
@@ -629,6 +656,11 @@ class FOWTModel:
             if linear_rotor:
                 mom_x += spin_share * np.outer(e_s, qa_x - qg_x)
                 mom_u += spin_share * np.outer(e_s, qa_u - qg_u)
+            if reference is None:
+                mean_moments[prefix] = (r_h @ q_static, mom_x[:, :N_DOF] @ q_static + mom_u[:, 0])
+            else:
+                mean_moments[prefix] = reference[prefix]
+            mom_x, mom_u = local_moment_rows(mom_x, mom_u, r_h, *mean_moments[prefix])
             suffix = ("MLyt", "MLxt") if prefix.startswith("TwHt") else ("Myt", "Mxt")
             rows_x[prefix + suffix[0]], rows_u[prefix + suffix[0]] = mom_x[1] / 1e3, mom_u[1] / 1e3
             rows_x[prefix + suffix[1]], rows_u[prefix + suffix[1]] = mom_x[0] / 1e3, mom_u[0] / 1e3
@@ -687,7 +719,7 @@ class FOWTModel:
         rows_x["RotThrust"], rows_u["RotThrust"] = rot_x / 1e3, rot_u / 1e3
         cmat = np.array([rows_x[ch] for ch in ALL_CHANNELS])
         dmat = np.array([rows_u[ch] for ch in ALL_CHANNELS])
-        return LinearSystem(a, b, cmat, dmat, tuple(ALL_CHANNELS), op, omega0, dict(eff), st, drag)
+        return LinearSystem(a, b, cmat, dmat, tuple(ALL_CHANNELS), op, omega0, dict(eff), st, drag, mean_moments)
 
     # ----------------------------------------------------------------------------------------- analysis
     def modal_analysis(self, case: int | LoadCase | None = None) -> ModalResult:
@@ -953,6 +985,79 @@ def _shear_hub_loads(op: OperatingPoint | None, radius: float, strength: float):
     per_gy = (np.array([0.0, 0.0, k_f]), np.array([0.0, 0.0, -k_my]))
     per_gz = (np.array([0.0, -k_f, 0.0]), np.array([0.0, k_m, 0.0]))
     return [per_gy, per_gz]
+
+
+def tilted_yaw_gravity_stiffness(structure: Structure, mean_pitch: float) -> np.ndarray:
+    """Geometric stiffness of the weights between the platform's yaw and the lateral deflections, at a mean pitch.
+
+    The platform's yaw ``y`` turns about its own (pitched) axis; its lateral axis ``y_p`` then rises out of the
+    horizontal by ``y sin(theta0)``. A body of mass ``m`` displaced laterally by ``d`` in the platform's axes (the
+    tower's side-to-side modes) rises by ``d y sin(theta0)``: potential energy ``m g sin(theta0) d y``, the
+    symmetric stiffness ``K[yaw, j] = K[j, yaw] = g sin(theta0) sum_b m_b T_b[y, j]`` (``T_b`` the body's
+    translation Jacobian). At rated wind (4 deg) the weight above the tower base pushes the tower sideways by
+    0.33 MN per rad of yaw (ElastoDyn's exact kinematics do the same). The platform's own coordinates (fixed-axes
+    translations, rotations about the platform's axes) carry no such term: a point on the spar's axis does not
+    move as it yaws.
+
+    Parameters
+    ----------
+    structure : Structure
+        The structural model (its bodies and their translation Jacobians).
+    mean_pitch : float
+        Mean platform pitch (rad).
+
+    Returns
+    -------
+    ndarray, shape (N_DOF, N_DOF)
+    """
+    k = np.zeros((N_DOF, N_DOF))
+    s0 = math.sin(float(mean_pitch))
+    for body in structure.bodies:
+        if body.name == "platform":
+            continue
+        row = GRAVITY * s0 * body.mass * body.translation[1, 6:]
+        k[5, 6:] += row
+        k[6:, 5] += row
+    return k
+
+
+def local_moment_rows(mom_x: np.ndarray, mom_u: np.ndarray, rotation: np.ndarray, theta0: np.ndarray,
+                      m0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Output rows of a tower section's bending moment in the section's own axes, as ElastoDyn reports it.
+
+    ElastoDyn's ``TwrBsMxt``/``TwrBsMyt`` are the moment vector ``M`` (fixed axes) of everything above the tower
+    base projected on the platform's axes, ``M . a1`` and ``M . a2`` (``TwHt*MLxt``/``MLyt`` likewise on the
+    gauge's section axes ``t1``, ``t2``). The axes turn with the section: by ``theta0`` under the mean loads
+    (the mean platform pitch and tower slope) and by ``delta theta`` about it, ``delta a = delta theta x a``, so
+    to first order ``M . a = dM . a0 + delta theta . (a0 x M0)`` (plus the mean ``M0 . a0``). At rated wind the
+    mean fore-aft moment (~72 MN m at the tower base) turns into the side-to-side axis with the platform's yaw:
+    1.2 MN m per degree, the part of OpenFAST's ``TwrBsMxt`` that follows its yaw in the wave band.
+
+    Parameters
+    ----------
+    mom_x, mom_u : ndarray, shape (3, n_x) and (3, n_u)
+        Rows of the moment vector in the fixed axes (N m) per state and per input (input 0: the constant one).
+    rotation : ndarray, shape (3, N_DOF)
+        Rotation Jacobian of the section (rad per generalised coordinate).
+    theta0 : ndarray, shape (3,)
+        The section's mean rotation (rad, fixed axes).
+    m0 : ndarray, shape (3,)
+        The mean moment vector (N m, fixed axes).
+
+    Returns
+    -------
+    (ndarray, ndarray)
+        The rows with components 0 and 1 in the section's axes (component 2 unchanged).
+    """
+    cy, sy = math.cos(theta0[1]), math.sin(theta0[1])
+    axes = (np.array([cy, theta0[2], -sy]), np.array([-theta0[2], 1.0, theta0[0]]))  # a1, a2 (exact in pitch)
+    out_x, out_u = mom_x.copy(), mom_u.copy()
+    for i, a0 in enumerate(axes):
+        out_x[i] = a0 @ mom_x
+        out_u[i] = a0 @ mom_u
+        out_x[i, :N_DOF] += np.cross(a0, m0) @ rotation
+        out_u[i, 0] -= np.cross(a0, m0) @ theta0  # the mean stays M0 . a0
+    return out_x, out_u
 
 
 def _tower_drag_strips(z0: float, z1: float, strength: float, n: int = 40):

@@ -785,14 +785,17 @@ class Simulator:
                 raise ValueError(f"initial: unknown channel {name!r}; known: {sorted(_INITIAL_CHANNELS)}")
         # ElastoDyn's roll and yaw are Euler angles and its rotational velocities fixed-axes components; the
         # model's roll and yaw turn about the platform's own, pitched axes (elastodyn_platform_angles)
+        # (a channel not given keeps its equilibrium value in ElastoDyn's terms)
         pitch = float(x[4])
+        p_eq = float(self.x_eq[4])
         if "PtfmRoll" in initial or "PtfmYaw" in initial:
-            roll_ed = np.deg2rad(float(initial["PtfmRoll"])) if "PtfmRoll" in initial else x[3] + math.tan(pitch) * x[5]
-            yaw_ed = np.deg2rad(float(initial["PtfmYaw"])) if "PtfmYaw" in initial else x[5] / math.cos(pitch)
+            r_eq, y_eq = float(self.x_eq[3]), float(self.x_eq[5])
+            roll_ed = np.deg2rad(float(initial["PtfmRoll"])) if "PtfmRoll" in initial else r_eq + math.tan(p_eq) * y_eq
+            yaw_ed = np.deg2rad(float(initial["PtfmYaw"])) if "PtfmYaw" in initial else y_eq / math.cos(p_eq)
             x[3], x[5] = body_platform_angles(float(roll_ed), pitch, float(yaw_ed))
         if "PtfmRVxi" in initial or "PtfmRVzi" in initial:
             c, s = math.cos(pitch), math.sin(pitch)
-            wr, wy = x[N_DOF + 3], x[N_DOF + 5]
+            wr, wy = self.x_eq[N_DOF + 3], self.x_eq[N_DOF + 5]
             wx = np.deg2rad(float(initial["PtfmRVxi"])) if "PtfmRVxi" in initial else c * wr + s * wy
             wz = np.deg2rad(float(initial["PtfmRVzi"])) if "PtfmRVzi" in initial else -s * wr + c * wy
             x[N_DOF + 3], x[N_DOF + 5] = c * wx - s * wz, s * wx + c * wz
