@@ -60,6 +60,7 @@ __all__ = [
     "band_std",
     "damage_equivalent_load",
     "decay_analysis",
+    "elastodyn_initial_conditions",
     "load_reference",
     "mean_tolerance",
     "packaged_reference_dir",
@@ -939,6 +940,66 @@ def _kind(case: Mapping[str, Any]) -> str:
 _RECORD_EXTENSIONS = (".outb", ".out", ".npz", ".csv", ".parquet")
 
 
+_ELASTODYN_INITIAL = {"PtfmSurge": "PtfmSurge", "PtfmSway": "PtfmSway", "PtfmHeave": "PtfmHeave",
+                      "PtfmRoll": "PtfmRoll", "PtfmPitch": "PtfmPitch", "PtfmYaw": "PtfmYaw", "TTDspFA": "TTDspFA",
+                      "TTDspSS": "TTDspSS", "RotSpeed": "RotSpeed", "BlPitch(1)": "BldPitch1"}
+
+
+def elastodyn_initial_conditions(path: str | os.PathLike[str]) -> dict[str, float]:
+    """The initial conditions of an ElastoDyn input file, under the names ``surrogates.simulate(initial=...)`` takes.
+
+    Reads the "INITIAL CONDITIONS" values (``value  Name  - description`` lines) of the platform
+    (``PtfmSurge`` ... ``PtfmYaw``; m, deg), the tower-top deflections (``TTDspFA``, ``TTDspSS``; m), the rotor speed
+    (``RotSpeed``, rpm) and blade 1's pitch (``BlPitch(1)``, deg, as ``BldPitch1``: the controller starts from it, as
+    the DLL does). The azimuth is left out (the surrogate's seeds draw it).
+
+    Parameters
+    ----------
+    path : str or path-like
+        An ElastoDyn primary input file (``*_ElastoDyn.dat``).
+
+    Returns
+    -------
+    dict
+        Channel name -> value (OpenFAST units); only the names found.
+
+    Raises
+    ------
+    ValueError
+        If the file cannot be read or holds none of them.
+    """
+    try:
+        lines = Path(path).read_text(encoding="utf-8", errors="replace").splitlines()
+    except OSError as exc:
+        raise ValueError(f"cannot read the ElastoDyn file {str(path)!r}: {exc}") from exc
+    out: dict[str, float] = {}
+    for line in lines:
+        parts = line.split()
+        if len(parts) >= 2 and parts[1] in _ELASTODYN_INITIAL and _ELASTODYN_INITIAL[parts[1]] not in out:
+            try:
+                value = float(parts[0])
+            except ValueError:
+                continue
+            if math.isfinite(value):
+                out[_ELASTODYN_INITIAL[parts[1]]] = value
+    if not out:
+        raise ValueError(f"{str(path)!r} holds no ElastoDyn initial condition ({', '.join(_ELASTODYN_INITIAL)})")
+    return out
+
+
+def _elastodyn_start(case_json: Path, name: str) -> dict[str, float] | None:
+    """The operating run's start (ElastoDyn's initial conditions) from the deck beside its ``case.json``, if any."""
+    candidates = [case_json.with_name(f"{name}_ElastoDyn.dat")]
+    if not candidates[0].is_file():
+        candidates = sorted(case_json.parent.glob("*ElastoDyn*.dat"))
+        if len(candidates) != 1:
+            return None
+    try:
+        return elastodyn_initial_conditions(candidates[0])
+    except ValueError:
+        return None
+
+
 def load_reference(reference: str | os.PathLike[str] | None = None, runs: Sequence[str] | None = None,
                    ) -> tuple[list[ReferenceRun], list[dict[str, str]]]:
     """Find and read the reference runs.
@@ -998,6 +1059,10 @@ def load_reference(reference: str | os.PathLike[str] | None = None, runs: Sequen
             if not wanted(name):
                 continue
             case = json.loads(cj.read_text(encoding="utf-8"))
+            if _kind(case) == "operating" and "start" not in case:
+                start = _elastodyn_start(cj, name)
+                if start:
+                    case["start"] = start
             files = [cj.with_name(name + ext) for ext in _RECORD_EXTENSIONS]
             rec_path = next((p for p in files if p.is_file()), None)
             if rec_path is None:
@@ -1395,7 +1460,10 @@ def validate(
     Notes
     -----
     Every simulation runs with ``noise=False``; the operating runs with ``transient`` = the run's
-    ``transient_s`` (100 s), the decays with ``transient=0`` from ``initial`` (OpenFAST channel names and units).
+    ``transient_s`` (100 s) from the run's ``start`` (OpenFAST's initial conditions: read from the ElastoDyn deck
+    beside a folder's ``case.json`` by :func:`elastodyn_initial_conditions`; the packaged runs carry them) or,
+    without one, from the static equilibrium; the decays with ``transient=0`` from ``initial`` (OpenFAST channel
+    names and units).
     The seeds of one run are simulated in parallel threads by :func:`surrogates.simulate`.
     """
     import surrogates
@@ -1460,7 +1528,11 @@ def validate(
             else:
                 dur = run.duration if duration is None else float(duration)
                 transient = float(run.case.get("transient_s") or 60.0)
-                sims = surrogates.simulate(model, case, dur, dt, seed_list, transient=transient, noise=False)
+                # from where OpenFAST started (its deck's initial conditions, case["start"]), through the same
+                # start-up: a run whose platform starts away from its equilibrium still rings in its record
+                start = run.case.get("start") if has_initial else None
+                sims = surrogates.simulate(model, case, dur, dt, seed_list, transient=transient, noise=False,
+                                           **({"initial": dict(start)} if start else {}))
             _compare_operating(compared, sims, report)
             if plot_path is not None:
                 p = _plot_operating(run, sims, plot_path / f"{run.name}.png", plot_channels)

@@ -735,10 +735,15 @@ class Simulator:
         harm = self.harm
         self.harm = harm.copy()
         self.harm[0] = 0.0  # the mean of the harmonics is zero
+        # the blades sample the mean sheared wind as they will in the simulation (its mean tilt and yaw moments and
+        # side force: the rotor's asymmetric loads), averaged over a third of a turn (the three blades' period)
+        blade = self._steady_blade_wind()
+        psis = np.linspace(0.0, 2.0 * np.pi / 3.0, 8, endpoint=False) if blade.shape[0] else np.zeros(1)
         x = np.zeros(N_STATE)
         try:
             for _ in range(300):
-                u, _ = self.loads(x, 0, 0.0, np.zeros(2), u_ex, vel, self.ctrl0.copy())
+                u = np.mean([self.loads(x, 0, float(p), np.zeros(2), u_ex, vel, self.ctrl0.copy(), blade)[0]
+                             for p in psis], axis=0)
                 q_new = -np.linalg.solve(a_qq, b_c + b_ex @ u_ex[0, 1:] + b_rest @ u[N_EX:])
                 done = np.max(np.abs(q_new - x[:N_DOF])) < 1e-10 * (1.0 + np.max(np.abs(q_new)))
                 x[:N_DOF] = 0.5 * (x[:N_DOF] + q_new)
@@ -747,6 +752,20 @@ class Simulator:
         finally:
             self.harm = harm
         return x
+
+    def _steady_blade_wind(self) -> np.ndarray:
+        """The blade-effective winds (1, N_BLADE_COLUMNS) of the case's mean sheared wind, as :meth:`forcing` builds
+        them from a field; empty when the rotor does not sample a field (no wind)."""
+        lc = self.case
+        if lc is None or lc.wind_speed <= 0:
+            return np.zeros((0, N_BLADE_COLUMNS), dtype=np.float32)
+        wd = synthesize_rotor_wind(lc.wind_speed, 0.0, 2 * FIELD_DT, FIELD_DT, seed=0, n_azimuth=FIELD_AZIMUTH,
+                                   return_field=True, grid_spacing=FIELD_GRID_SPACING)
+        w_ip = inplane_ring_weights(wd.polar_radii, lc.wind_speed)[0]
+        row = np.concatenate([
+            blade_effective_wind(wd.polar_u[:1], wd.polar_radii, wd.polar_azimuth_rad, N_BLADE_AZIMUTH),
+            blade_effective_wind(wd.polar_u[:1], wd.polar_radii, wd.polar_azimuth_rad, N_BLADE_AZIMUTH, w_ip)], axis=1)
+        return np.ascontiguousarray(row, dtype=np.float32)
 
     def initial_state(self, initial: Mapping[str, float] | None) -> tuple[np.ndarray, np.ndarray]:
         """State and controller state to start from: the equilibrium, with ``initial`` (OpenFAST channel name ->

@@ -91,11 +91,13 @@ def _kalman_band_r2(truth: dict, filter_model: dict | None, seeds=(0, 1)) -> np.
 
 @pytest.mark.slow
 def test_a_wrong_tower_stiffness_costs_the_nominal_kalman_filter_on_every_seed():
-    """EI x0.95 moves the tower modes the filter relates hidden and live gauges through: given the nominal
-    model it must do worse than given the true one, seed by seed."""
-    truth = STANDARD_PERTURBATIONS["tower stiffness x0.95"]
+    """EI x0.8 moves the tower modes (-11 % in frequency) the filter relates hidden and live gauges through: given
+    the nominal model it must do worse than given the true one, seed by seed (3-6e-4 in band-passed R²). The
+    table's x0.95 cost 1.6-5.4e-5 while the tower moments were reported in fixed axes; in the sections' axes it
+    costs nothing measurable (-1e-5 to -2e-5 on seeds 0-1, below the other model errors of the linear filter)."""
+    truth = {"tower_stiffness": 0.8}
     wrong, right = _kalman_band_r2(truth, None), _kalman_band_r2(truth, truth)
-    assert np.all(wrong < right), (wrong, right)
+    assert np.all(wrong < right - 1e-4), (wrong, right)
 
 
 @pytest.mark.slow

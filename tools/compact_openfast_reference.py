@@ -173,7 +173,12 @@ def main(argv: list[str] | None = None) -> int:
         small = compact(rec, chans, fs_out, name, f"{name}/{outb.name}")
         npz = out / f"{name}.npz"
         small.save(npz)
-        shutil.copyfile(case_path, out / f"{name}.case.json")
+        start = validation._elastodyn_start(case_path, name) if kind == "operating" else None
+        if start and "start" not in case:  # where OpenFAST started: its deck's ElastoDyn initial conditions
+            (out / f"{name}.case.json").write_text(json.dumps({**case, "start": start}, indent=1) + "\n",
+                                                   encoding="utf-8")
+        else:
+            shutil.copyfile(case_path, out / f"{name}.case.json")
         info: dict = {
             "kind": kind,
             "source": {"path": str(outb), "bytes": outb.stat().st_size, "sha256": sha256(outb),
