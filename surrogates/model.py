@@ -235,6 +235,10 @@ class LinearSystem:
     effects: dict[str, float]
     structure: Structure = field(repr=False)
     drag: DragStrips | None = field(default=None, repr=False)
+    mean_pitch: float = 0.0
+    """Mean platform pitch (rad) under the operating point's mean loads: the ``PtfmRoll``/``PtfmYaw`` rows map the
+    platform's body-axes roll and yaw to ElastoDyn's Euler angles about it (``simulate`` adds the rest of that
+    map at the instantaneous pitch)."""
     mean_moments: dict[str, tuple[np.ndarray, np.ndarray]] | None = field(default=None, repr=False)
     """Per tower section (``"TwrBs"``, ``"TwHt1"`` ...): its mean rotation (rad) and mean bending-moment vector
     (N m, fixed axes) under the operating point's mean loads (:func:`local_moment_rows`)."""
@@ -674,6 +678,9 @@ class FOWTModel:
             rx = np.zeros(n_x)
             rx[i] = 1.0 if i < 3 else np.rad2deg(1.0)
             rows_x[name], rows_u[name] = rx, np.zeros(n_u)
+        # ElastoDyn's Euler angles about the mean pitch: roll r + y tan(p0), yaw y / cos(p0) (elastodyn_platform_angles)
+        rows_x["PtfmRoll"][5] = np.rad2deg(math.tan(mean_pitch))
+        rows_x["PtfmYaw"][5] = np.rad2deg(1.0 / math.cos(mean_pitch))
         rx = np.zeros(n_x)
         rx[2 * N_DOF] = 30.0 / np.pi
         ru = np.zeros(n_u)
@@ -719,7 +726,8 @@ class FOWTModel:
         rows_x["RotThrust"], rows_u["RotThrust"] = rot_x / 1e3, rot_u / 1e3
         cmat = np.array([rows_x[ch] for ch in ALL_CHANNELS])
         dmat = np.array([rows_u[ch] for ch in ALL_CHANNELS])
-        return LinearSystem(a, b, cmat, dmat, tuple(ALL_CHANNELS), op, omega0, dict(eff), st, drag, mean_moments)
+        return LinearSystem(a, b, cmat, dmat, tuple(ALL_CHANNELS), op, omega0, dict(eff), st, drag, mean_pitch,
+                            mean_moments)
 
     # ----------------------------------------------------------------------------------------- analysis
     def modal_analysis(self, case: int | LoadCase | None = None) -> ModalResult:

@@ -78,7 +78,7 @@ _PLATFORM_RATE = {"PtfmTVxi": 0, "PtfmTVyi": 1, "PtfmTVzi": 2, "PtfmRVxi": 3, "P
 _INITIAL_CHANNELS = (*_PLATFORM_DOF, *_PLATFORM_RATE, "TTDspFA", "TTDspSS", "RotSpeed", "BldPitch1", "GenTq")
 
 
-def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: int) -> None:
+def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: int, mean_pitch: float = 0.0) -> None:
     """Turn the model's platform roll and yaw (deg, in place in ``y`` of shape (n, channels)) into ElastoDyn's.
 
     The model's roll ``r`` and yaw ``y`` are small rotations about the platform's own axes, which pitch with it: a
@@ -94,10 +94,15 @@ def elastodyn_platform_angles(y: np.ndarray, i_roll: int, i_pitch: int, i_yaw: i
     0.8-0.95), is 0.078-0.092 deg/deg at 12 m/s (mean pitch 4.1 deg, sin 0.072) and 0.044-0.048 at 18 m/s
     (2.8 deg, sin 0.049). (ElastoDyn before v5 used the rotation vector of ``SmllRotTrans``, which would show
     ``p y / 2``.) :func:`body_platform_angles` is the inverse.
+
+    With ``mean_pitch`` (rad) ``y`` already holds that map about the mean pitch ``p0`` (the linear model's rows:
+    roll ``r + y tan(p0)``, yaw ``y / cos(p0)``, :attr:`surrogates.model.LinearSystem.mean_pitch`); only the rest,
+    at the instantaneous pitch, is added.
     """
     p = np.deg2rad(y[:, i_pitch])
-    y[:, i_roll] += np.tan(p) * y[:, i_yaw]
-    y[:, i_yaw] /= np.cos(p)
+    y_body = y[:, i_yaw] * math.cos(mean_pitch)
+    y[:, i_roll] += (np.tan(p) - math.tan(mean_pitch)) * y_body
+    y[:, i_yaw] = y_body / np.cos(p)
 
 
 def body_platform_angles(roll: float, pitch: float, yaw: float) -> tuple[float, float]:
@@ -913,7 +918,7 @@ class Simulator:
         """Channel values ``C x + D u`` from stored states and inputs (n, 55), with ``PtfmRoll`` and ``PtfmYaw`` as
         ElastoDyn reports them (:func:`elastodyn_platform_angles`)."""
         y = x_hist @ self.cy.T + u_ex_out @ self.dy[:, :N_EX].T + u_hist @ self.dy[:, N_EX:].T
-        elastodyn_platform_angles(y, self._i_roll, self._i_pitch, self._i_yaw)
+        elastodyn_platform_angles(y, self._i_roll, self._i_pitch, self._i_yaw, self.system.mean_pitch)
         return y
 
     def add_noise(self, y: np.ndarray, seed_sequence: np.random.SeedSequence) -> np.ndarray:

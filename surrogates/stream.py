@@ -219,7 +219,8 @@ class StreamingSimulator:
             done += m
         self.time += n_samples * self.dt
         truth = buf @ self._cd.T
-        elastodyn_platform_angles(truth, sim._i_roll, sim._i_pitch, sim._i_yaw)  # as simulate() reports them
+        elastodyn_platform_angles(truth, sim._i_roll, sim._i_pitch, sim._i_yaw,  # as simulate() reports them
+                                  sim.system.mean_pitch)
         if not noise or not self._noisy:
             return truth, truth
         e = self._noise_rng.standard_normal((2, n_samples, len(self.channels)))

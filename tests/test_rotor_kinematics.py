@@ -43,6 +43,28 @@ def test_platform_angles_match_elastodyn_euler_angles(pitch_deg, roll_deg, yaw_d
     assert np.rad2deg([r, yw]) == pytest.approx([roll_deg, yaw_deg], abs=1e-9)
 
 
+def test_linearised_platform_angles_are_elastodyns_about_the_mean_pitch():
+    # linearize()'s PtfmRoll/PtfmYaw rows: the derivative of ElastoDyn's Euler angles with respect to the body
+    # axes roll and yaw at the mean pitch p0 (exact rotation algebra: roll tan(p0), yaw 1 / cos(p0) per body yaw)
+    model = surrogates.FOWTModel()
+    case = surrogates.operating_case(12.0, 2.5, 10.0)
+    sys_ = model.linearize(case)
+    p0 = model._system(case, False).mean_pitch
+    assert np.deg2rad(3.0) < p0 < np.deg2rad(5.5)
+    h = 1e-6
+    rot = Rotation.from_euler("y", p0) * Rotation.from_rotvec([0.0, 0.0, h])
+    d_euler = (_elastodyn_angles(rot) - np.array([0.0, p0, 0.0])) / h
+    i_r, i_y = sys_.output_labels.index("PtfmRoll"), sys_.output_labels.index("PtfmYaw")
+    assert np.deg2rad(sys_.C[i_r, 5]) == pytest.approx(d_euler[0], rel=1e-4)
+    assert np.deg2rad(sys_.C[i_y, 5]) == pytest.approx(d_euler[2], rel=1e-4)
+    assert np.deg2rad(sys_.C[i_r, 3]) == pytest.approx(1.0) and sys_.C[i_y, 3] == 0.0
+    # and simulate() adds only the rest of the map: at the mean pitch nothing
+    y = np.array([[0.3, np.rad2deg(p0), 1.2]])
+    expect = y.copy()
+    elastodyn_platform_angles(y, 0, 1, 2, p0)
+    assert np.allclose(y, expect)
+
+
 def test_initial_platform_angles_are_elastodyns():
     # a free decay started from ElastoDyn's roll and yaw at a pitch reports them back at the release
     model = surrogates.FOWTModel()

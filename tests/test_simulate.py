@@ -224,9 +224,11 @@ def test_linear_simulation_matches_lsim_of_linearize():
     t = np.arange(n) * dt
     _, y_dev, _ = lsim((ss.A, ss.B, ss.C, ss.D), u, t, interp=True)
     y_eq = sim.system.C @ sim.x_eq + sim.system.D[:, 0]
-    # the platform angles are reported as ElastoDyn's (a second-order output map, applied to both)
+    # the platform angles are reported as ElastoDyn's: linear about the mean pitch in C, the rest of the map
+    # (second order) applied to both
     y_lin = y_dev + y_eq
-    elastodyn_platform_angles(y_lin, *(rec.channels.index(c) for c in ("PtfmRoll", "PtfmPitch", "PtfmYaw")))
+    elastodyn_platform_angles(y_lin, *(rec.channels.index(c) for c in ("PtfmRoll", "PtfmPitch", "PtfmYaw")),
+                              sim.system.mean_pitch)
     y_dev = y_lin - y_eq
     # Wave1Elev and Wind1VelX are pass-through channels, not outputs of the linear dynamics
     keep = [i for i, c in enumerate(rec.channels) if c not in ("Wave1Elev", "Wind1VelX")]
