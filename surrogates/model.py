@@ -235,6 +235,7 @@ class LinearSystem:
     effects: dict[str, float]
     structure: Structure = field(repr=False)
     drag: DragStrips | None = field(default=None, repr=False)
+    """The Morison drag strips with the equivalent linearisation held in ``A`` (and in the wave forcing)."""
     mean_pitch: float = 0.0
     """Mean platform pitch (rad) under the operating point's mean loads: the ``PtfmRoll``/``PtfmYaw`` rows map the
     platform's body-axes roll and yaw to ElastoDyn's Euler angles about it (``simulate`` adds the rest of that
@@ -242,7 +243,6 @@ class LinearSystem:
     mean_moments: dict[str, tuple[np.ndarray, np.ndarray]] | None = field(default=None, repr=False)
     """Per tower section (``"TwrBs"``, ``"TwHt1"`` ...): its mean rotation (rad) and mean bending-moment vector
     (N m, fixed axes) under the operating point's mean loads (:func:`local_moment_rows`)."""
-    """The Morison drag strips with the equivalent linearisation held in ``A`` (and in the wave forcing)."""
 
     def equilibrium(self, nonlinear_force=None, tol: float = 1e-10) -> np.ndarray:
         """Static equilibrium state under the mean loads (and an optional ``nonlinear_force(x) -> (N_DOF,)``)."""

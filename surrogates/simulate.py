@@ -51,7 +51,7 @@ from .structure import _CYCLIC, N_DOF
 from .structure import _FLAP as FLAP
 from .validation import check_number
 from .waves import synthesize_waves
-from .wind import TURBSIM_GRID_SPACING, synthesize_rotor_wind
+from .wind import TURBSIM_GRID_SPACING, RotorWind, synthesize_rotor_wind
 
 
 def mean_shear_z(wind_speed: float, exponent: float = 0.2, hub_height: float = 90.0, radius: float = 63.0) -> float:
@@ -121,6 +121,16 @@ def body_platform_angles(roll: float, pitch: float, yaw: float) -> tuple[float, 
     """
     y = yaw * math.cos(pitch)
     return roll - math.tan(pitch) * y, y
+
+
+def _blade_wind_columns(wind: RotorWind, wind_speed: float) -> np.ndarray:
+    """The stepper's blade winds (n_field, N_BLADE_COLUMNS) of a synthesised rotor field (``RotorWind`` with its
+    polar field): the wind along each blade at ``N_BLADE_AZIMUTH`` azimuths weighted as its thrust and torque
+    answer it, then as its in-plane force does (ring weights at ``wind_speed``)."""
+    w_ip = inplane_ring_weights(wind.polar_radii, wind_speed)[0]
+    return np.concatenate([
+        blade_effective_wind(wind.polar_u, wind.polar_radii, wind.polar_azimuth_rad, N_BLADE_AZIMUTH),
+        blade_effective_wind(wind.polar_u, wind.polar_radii, wind.polar_azimuth_rad, N_BLADE_AZIMUTH, w_ip)], axis=1)
 
 
 # ------------------------------------------------------------------------------------------------ kernel
@@ -766,11 +776,7 @@ class Simulator:
             return np.zeros((0, N_BLADE_COLUMNS), dtype=np.float32)
         wd = synthesize_rotor_wind(lc.wind_speed, 0.0, 2 * FIELD_DT, FIELD_DT, seed=0, n_azimuth=FIELD_AZIMUTH,
                                    return_field=True, grid_spacing=FIELD_GRID_SPACING)
-        w_ip = inplane_ring_weights(wd.polar_radii, lc.wind_speed)[0]
-        row = np.concatenate([
-            blade_effective_wind(wd.polar_u[:1], wd.polar_radii, wd.polar_azimuth_rad, N_BLADE_AZIMUTH),
-            blade_effective_wind(wd.polar_u[:1], wd.polar_radii, wd.polar_azimuth_rad, N_BLADE_AZIMUTH, w_ip)], axis=1)
-        return np.ascontiguousarray(row, dtype=np.float32)
+        return np.ascontiguousarray(_blade_wind_columns(wd, lc.wind_speed)[:1], dtype=np.float32)
 
     def initial_state(self, initial: Mapping[str, float] | None) -> tuple[np.ndarray, np.ndarray]:
         """State and controller state to start from: the equilibrium, with ``initial`` (OpenFAST channel name ->
@@ -897,10 +903,7 @@ class Simulator:
             u_ex[:, INPUT_BLOCKS["hub_wind"].start] = np.interp(t, wd.t, wd.hub)
             u_ex[:, INPUT_BLOCKS["shear"].start] = np.interp(t, wd.t, wd.shear_y)
             u_ex[:, INPUT_BLOCKS["shear"].start + 1] = np.interp(t, wd.t, wd.shear_z)
-            w_ip = inplane_ring_weights(wd.polar_radii, lc.wind_speed)[0]
-            on_blade = np.concatenate([  # (n_field, N_BLADE_COLUMNS): thrust and torque's, then in-plane
-                blade_effective_wind(wd.polar_u, wd.polar_radii, wd.polar_azimuth_rad, N_BLADE_AZIMUTH),
-                blade_effective_wind(wd.polar_u, wd.polar_radii, wd.polar_azimuth_rad, N_BLADE_AZIMUTH, w_ip)], axis=1)
+            on_blade = _blade_wind_columns(wd, lc.wind_speed)
             # each azimuth meets the frozen field with its own delay (the disc is tilted: blade_sampling_delay)
             delay = np.tile(self.blade_sampling_delay(), 2)
             t_field = np.arange(on_blade.shape[0]) * FIELD_DT
