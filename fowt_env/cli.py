@@ -385,7 +385,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 
     progress = None  # a bar on a terminal, once a step has run 2 s
     rep = validate(args.reference, seeds=args.seeds, duration=args.duration, runs=args.runs, plot_dir=args.plot,
-                   progress=progress, replay=args.replay)
+                   progress=progress, replay=args.replay, constrain_wind=not args.free_wind)
     print(rep.summary(graded_only=not args.all_channels), end="")
     if args.json:
         rep.to_json(args.json)
@@ -999,6 +999,10 @@ def build_parser() -> argparse.ArgumentParser:
                          "beside each record, else Wind1VelX) instead of random seeds; adds R² per channel and band "
                          "against OpenFAST with its linear bound (seeds then vary only the initial rotor azimuth; "
                          "--duration is ignored)")
+    vd.add_argument("--free-wind", action="store_true",
+                    help="draw the turbulence at the case's nominal intensity without conditioning it on the record's "
+                         "Wind1VelX (default: the field is drawn given the measured hub wind, which repeats the "
+                         "run's slow gusts)")
     vd.set_defaults(func=_cmd_validate)
 
     f = sub.add_parser("fatigue", help="damage-equivalent loads (rainflow) of a record's tower moments")

@@ -1142,15 +1142,17 @@ def surrogate_case(case: Mapping[str, Any]) -> Any:
                                turbulence_intensity=float(ti), gamma=gamma, name=name)
 
 
-def _with_measured_inputs(run: ReferenceRun) -> dict[str, Any]:
+def _with_measured_inputs(run: ReferenceRun, realised_ti: bool = False) -> dict[str, Any]:
     """The run's conditions with ``wind_speed`` replaced by the mean hub-height wind the run actually saw
     (``Wind1VelX`` over its record; a turbulence generator's realised mean differs from its nominal one:
-    8.19, 11.79 and 17.75 m/s in the shared runs for nominal 8, 12 and 18), a turbulent run's
-    ``turbulence_intensity`` by the realised hub-height intensity ``std/mean`` of ``Wind1VelX`` (0.169, 0.200 and
-    0.144 for the nominal IEC class B 0.203, 0.170 and 0.149: a 600 s TurbSim realisation is far from its nominal
-    level) and ``hs`` by the significant wave height of its ``Wave1Elev`` (4 standard deviations). The nominal
-    values stay in ``*_nominal`` keys. Nothing else is taken from the record: the inputs' realised levels, never
-    the response."""
+    8.19, 11.79 and 17.75 m/s in the shared runs for nominal 8, 12 and 18) and ``hs`` by the spectral
+    significant wave height ``Hm0 = 4 sqrt(m0)`` of its ``Wave1Elev`` (``m0`` the area of its :func:`psd`).
+    With ``realised_ti`` a turbulent run's ``turbulence_intensity`` is also replaced by the realised hub-height
+    intensity ``std/mean`` of ``Wind1VelX`` (0.169, 0.200 and 0.144 for the nominal IEC class B 0.203, 0.170 and
+    0.149); otherwise the case's nominal intensity stays (``validate`` conditions the field on the measured hub
+    series instead, which carries the realisation's level where it departs from nominal: in its slowest gusts).
+    The nominal values stay in ``*_nominal`` keys. Nothing else is taken from the record: the inputs' realised
+    levels, never the response."""
     case = dict(run.case)
     rec = run.record
     if (rec is not None and "Wind1VelX" in getattr(rec, "channels", ()) and float(case.get("wind_speed") or 0) > 0):
@@ -1159,18 +1161,37 @@ def _with_measured_inputs(run: ReferenceRun) -> dict[str, Any]:
             case["wind_speed_nominal"] = case.get("wind_speed")
             case["wind_speed"] = measured
             ti = case.get("turbulence_intensity")
-            if ti is not None and float(ti) > 0:  # turbulent runs: the realised hub-height intensity
+            if realised_ti and ti is not None and float(ti) > 0:  # turbulent runs: the realised hub intensity
                 case["turbulence_intensity_nominal"] = ti
                 case["turbulence_intensity"] = float(np.std(rec["Wind1VelX"])) / measured
-    # likewise the sea state the run actually saw: Hs = 4 std(Wave1Elev) of its record (a 300-600 s realisation
-    # of a JONSWAP sea departs from the nominal Hs by several per cent: 2.84 m for the nominal 2.5 m of the
-    # shared steady-wind run, 4.34 m for 4.0 m at 18 m/s), the spectral shape and Tp kept
+    # likewise the sea state the run actually saw: its spectral significant height Hm0 = 4 sqrt(m0), m0 the area
+    # of the record's Welch spectrum -- the estimator the report's bands use, so the Wave1Elev rows agree. A
+    # 300-600 s realisation of a JONSWAP sea departs from the nominal Hs by several per cent (2.97 m for the nominal
+    # 2.5 m of the shared steady-wind run); where its largest waves fall near the record's ends the two estimates
+    # part: the 18 m/s run has 4 std = 4.34 m and Hm0 = 3.79 m (its wave band alone holds 3.75 m). Shape, Tp kept.
     if (rec is not None and "Wave1Elev" in getattr(rec, "channels", ()) and float(case.get("hs") or 0) > 0):
-        measured_hs = 4.0 * float(np.std(rec["Wave1Elev"]))
+        elevation = np.asarray(rec["Wave1Elev"], dtype=float)
+        t_rec = np.asarray(rec.t, dtype=float)
+        f, p = psd(elevation, 1.0 / float(np.median(np.diff(t_rec))))
+        measured_hs = 4.0 * math.sqrt(max(float(np.sum(p)) * float(f[1] - f[0]), 0.0))
         if np.isfinite(measured_hs) and measured_hs > 0:
             case["hs_nominal"] = case.get("hs")
             case["hs"] = measured_hs
     return case
+
+
+def _measured_hub_wind(run: ReferenceRun, case: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """The record's ``(t, Wind1VelX)`` to condition a turbulent run's synthesised field on, or None (no such
+    channel, a non-turbulent case, or a series with gaps)."""
+    rec = run.record
+    if case is None or not (case.wind_speed > 0 and case.turbulence_intensity > 0):
+        return None
+    if rec is None or "Wind1VelX" not in getattr(rec, "channels", ()):
+        return None
+    t, u = np.asarray(rec.t, dtype=float), np.asarray(rec["Wind1VelX"], dtype=float)
+    if t.size < 2 or not (np.all(np.isfinite(u)) and np.all(np.diff(t) > 0)):
+        return None
+    return t, u
 
 
 def _simulate_supports_initial() -> bool:
@@ -1377,7 +1398,7 @@ def _replay_operating(run: ReferenceRun, model: Any, seeds: Sequence[int], dt: f
     inflow = Path(run.source).with_name(f"{run.name}.inflow.npz") if run.source else None
     has_inflow = inflow is not None and inflow.is_file()
     wind = MeasuredWind.from_inflow(inflow) if has_inflow else None  # read once for every seed
-    case = _with_measured_inputs(run)
+    case = _with_measured_inputs(run, realised_ti=True)
     sims = [replay_record(run.record, case=case, wind=wind, model=model, transient=REPLAY_TRANSIENT_S, dt=dt,
                           seed=int(s)) for s in seeds]
     rotor_wind = None
@@ -1405,6 +1426,7 @@ def validate(
     base_seed: int = 0,
     progress: bool | None = False,
     replay: bool = False,
+    constrain_wind: bool = True,
 ) -> ValidationReport:
     """Compare the surrogate with OpenFAST reference runs, channel by channel.
 
@@ -1447,6 +1469,14 @@ def validate(
         then vary only the rotor's initial azimuth; the statistics are graded as without replay (over the
         replay's window, against OpenFAST's over its whole window) and the report adds, per channel and band,
         the replay's R² against OpenFAST's series with its linear bound (``report.replay``).
+    constrain_wind : bool
+        Without replay: draw each turbulent run's field conditioned on the record's hub-height wind
+        ``Wind1VelX`` (``surrogates.simulate(hub_wind=...)``, :func:`surrogates.wind.constrain_to_hub`) at the
+        case's nominal turbulence intensity (default). A 10-minute TurbSim draw departs from its nominal
+        spectrum mostly in its few slowest components (the shared 12 m/s run's hub wind carries 1.9x and 1.4x the
+        Kaimal density in 0.005-0.02 and 0.02-0.05 Hz, 0.66x in 0.05-0.1 Hz, within 5 % above 0.1 Hz); the
+        constraint repeats them while the rotor plane stays random. False: the nominal intensity, unconstrained
+        (a purely statistical comparison).
 
     Returns
     -------
@@ -1491,6 +1521,7 @@ def validate(
                                                     f"where larger; bands with < 1 % of the variance not graded"},
                        "del": _DEL_REL, "decay": DECAY_TOLERANCE},
         "replay": bool(replay),
+        "constrain_wind": bool(constrain_wind) and not replay,
     }
     has_initial = _simulate_supports_initial()
     figs: list[str] = []
@@ -1531,8 +1562,14 @@ def validate(
                 # from where OpenFAST started (its deck's initial conditions, case["start"]), through the same
                 # start-up: a run whose platform starts away from its equilibrium still rings in its record
                 start = run.case.get("start") if has_initial else None
+                extra: dict[str, Any] = {"initial": dict(start)} if start else {}
+                hub = _measured_hub_wind(run, case) if constrain_wind else None
+                if hub is not None:
+                    extra["hub_wind"] = hub
+                    report.notes.append(f"{run.name}: the surrogate's turbulence is conditioned on the record's "
+                                        "Wind1VelX (its Wind1VelX rows compare the constraint with itself)")
                 sims = surrogates.simulate(model, case, dur, dt, seed_list, transient=transient, noise=False,
-                                           **({"initial": dict(start)} if start else {}))
+                                           **extra)
             _compare_operating(compared, sims, report)
             if plot_path is not None:
                 p = _plot_operating(run, sims, plot_path / f"{run.name}.png", plot_channels)

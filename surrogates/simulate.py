@@ -51,7 +51,7 @@ from .structure import _CYCLIC, N_DOF
 from .structure import _FLAP as FLAP
 from .validation import check_number
 from .waves import synthesize_waves
-from .wind import TURBSIM_GRID_SPACING, RotorWind, synthesize_rotor_wind
+from .wind import TURBSIM_GRID_SPACING, RotorWind, constrain_to_hub, synthesize_rotor_wind
 
 
 def mean_shear_z(wind_speed: float, exponent: float = 0.2, hub_height: float = 90.0, radius: float = 63.0) -> float:
@@ -873,12 +873,15 @@ class Simulator:
         psi = np.arange(N_BLADE_AZIMUTH) * 2.0 * np.pi / N_BLADE_AZIMUTH
         return BLADE_SAMPLING_RADIUS * st.data.tip_radius * np.cos(psi) * np.sin(chi) / float(speed)
 
-    def forcing(self, n_steps: int, seed_sequence: np.random.SeedSequence
+    def forcing(self, n_steps: int, seed_sequence: np.random.SeedSequence,
+                hub_wind: tuple[np.ndarray, np.ndarray] | None = None,
                 ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
         """Exogenous inputs for ``n_steps`` internal steps (+1 sample for the hold), strip velocities, initial
         rotor azimuth, and the blade-effective wind around the rotor (``(n, n_azimuth)`` float32: the turbulent
         field over the disc averaged along a blade with weights proportional to the radius, at azimuths
-        measured from the top towards +y; empty without turbulent wind)."""
+        measured from the top towards +y; empty without turbulent wind). ``hub_wind`` = ``(t, u)`` (s from the
+        start of the simulation, m/s) conditions the turbulent field on that hub-height series
+        (:func:`surrogates.wind.constrain_to_hub`)."""
         wave_ss, wind_ss, psi_ss = seed_sequence.spawn(3)
         n = n_steps + 1
         duration = n * self.dt_int
@@ -898,6 +901,8 @@ class Simulator:
             wd = synthesize_rotor_wind(lc.wind_speed, lc.turbulence_intensity, duration + 2 * FIELD_DT, FIELD_DT,
                                        seed=int(wind_ss.generate_state(1)[0]), n_azimuth=FIELD_AZIMUTH,
                                        return_field=True, grid_spacing=FIELD_GRID_SPACING)
+            if hub_wind is not None and lc.turbulence_intensity > 0:
+                wd = constrain_to_hub(wd, hub_wind[0], hub_wind[1])
             t = np.arange(n) * self.dt_int
             u_ex[:, INPUT_BLOCKS["wind"].start] = np.interp(t, wd.t, wd.rotor_effective) - lc.wind_speed
             u_ex[:, INPUT_BLOCKS["hub_wind"].start] = np.interp(t, wd.t, wd.hub)
@@ -941,6 +946,34 @@ class Simulator:
         return out
 
 
+def _hub_wind_series(hub_wind: object, sim: Simulator, replayed_wind: bool) -> tuple[np.ndarray, np.ndarray]:
+    """``simulate(hub_wind=...)`` as ``(t, u)`` with ``t`` from 0 at the series' first sample (s, m/s)."""
+    if replayed_wind:
+        raise ValueError("hub_wind conditions the synthesised turbulence; wind= replays a measured wind instead: "
+                         "give one of them")
+    lc = sim.case
+    if lc is None or not (lc.wind_speed > 0 and lc.turbulence_intensity > 0):
+        raise ValueError("hub_wind conditions the synthesised turbulence: the case needs wind_speed > 0 and "
+                         "turbulence_intensity > 0 (the level of the field's random rest)")
+    if isinstance(hub_wind, Record):
+        if "Wind1VelX" not in hub_wind.channels:
+            raise ValueError("hub_wind: the record has no Wind1VelX channel")
+        t, u = hub_wind.t, hub_wind["Wind1VelX"]
+    elif isinstance(hub_wind, tuple | list) and len(hub_wind) == 2:
+        t, u = hub_wind
+    else:
+        raise ValueError(f"hub_wind must be a Record with Wind1VelX or a (t, u) pair, got {type(hub_wind).__name__}")
+    t = np.asarray(t, dtype=float)
+    u = np.asarray(u, dtype=float)
+    if t.ndim != 1 or u.shape != t.shape or t.size < 2:
+        raise ValueError(f"hub_wind: t and u must be 1-D of the same length >= 2, got shapes {t.shape}, {u.shape}")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(u))):
+        raise ValueError("hub_wind must be finite (fill or cut the gaps of a measured series first)")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("hub_wind: t must be strictly increasing")
+    return t - t[0], u
+
+
 def simulate(
     model: FOWTModel,
     case: int | LoadCase | None,
@@ -955,6 +988,7 @@ def simulate(
     waves: object = None,
     wind: object = None,
     azimuth: object = None,
+    hub_wind: object = None,
     on_progress: Callable[[float], None] | None = None,
 ) -> Record | list[Record]:
     """Simulate the surrogate under a load case and return its 45 sensor channels.
@@ -1003,6 +1037,15 @@ def simulate(
         the simulated one continues). The rotationally sampled loads are phase-locked to the blades: a rotor
         speed 0.1 % off shifts their 3P phase by ~90° within ten minutes, so a twin replays the measured azimuth
         as it replays the measured wind. The rotor speed stays the simulation's own.
+    hub_wind : Record or (t, u), optional
+        Condition the synthesised turbulence on a measured hub-height wind (a record's ``Wind1VelX``, a met
+        mast's or nacelle anemometer's series; m/s): the field is drawn from the IEC model *given* that series
+        (:func:`surrogates.wind.constrain_to_hub`), so the record's ``Wind1VelX`` follows it and its slow gusts
+        load the rotor, while the rest of the rotor plane stays random (the seed). Its first sample is placed at
+        the returned record's first (after ``transient``); the constraint fades in over the last 20 s of the
+        transient and out after the series ends. Only its fluctuation is used: the case's ``wind_speed`` is the
+        mean (give the series' mean). Needs a turbulent case (``wind_speed`` and ``turbulence_intensity`` > 0,
+        the level of the random rest); not with ``wind=``.
     on_progress : callable, optional
         A progress bar's hook: called with the simulated seconds (transient included) just integrated, about
         every 1 % of each seed's run; ``(duration + transient) * n_seeds`` seconds in all. With several seeds it
@@ -1048,6 +1091,7 @@ def simulate(
     if any(s < 0 for s in seeds):
         raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
     sim = Simulator(model, case, dt)
+    hub_series = None if hub_wind is None else _hub_wind_series(hub_wind, sim, wind is not None)
     n_out = int(round(duration / sim.dt))
     if n_out < 2:
         raise ValueError(f"duration={duration} s is shorter than two samples of dt={sim.dt} s")
@@ -1070,7 +1114,8 @@ def simulate(
             if az_series is not None:
                 blade = with_measured_azimuth(blade, t_start + np.arange(n_steps + 1) * sim.dt_int, *az_series)
         else:
-            u_ex, vel, psi0, blade = sim.forcing(n_steps, forcing_seq)
+            u_ex, vel, psi0, blade = sim.forcing(n_steps, forcing_seq, None if hub_series is None else
+                                                 (hub_series[0] + n_skip * sim.dt, hub_series[1]))
         if psi_start is not None:
             psi0 = psi_start
         x, ctrl = x_start.copy(), ctrl_start.copy()
@@ -1111,6 +1156,9 @@ def simulate(
             "noise": bool(noise),
             "initial": dict(initial) if initial else None,
         }
+        if hub_series is not None:
+            meta["hub_wind"] = {"t_start": float(hub_series[0][0]), "t_end": float(hub_series[0][-1]),
+                                "series_mean": float(np.mean(hub_series[1]))}
         if replay:
             meta["replay"] = replay_meta(waves, wind, t_start,
                                          None if wind is None else advection_delay(sim, wind))

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
-from scipy.fft import irfft, next_fast_len
+from scipy.fft import irfft, next_fast_len, rfft
 from scipy.interpolate import PchipInterpolator
 
 from .validation import check_number
@@ -40,6 +40,7 @@ __all__ = [
     "RotorWind",
     "TURBSIM_GRID_SPACING",
     "WindSeries",
+    "constrain_to_hub",
     "grid_interpolation_variance",
     "iec_turbulence_intensity",
     "kaimal_spectrum",
@@ -880,3 +881,99 @@ def synthesize_rotor_wind(
             r0 = max(j0, 1)
             flat[:, r0 + n_azimuth - 1: j1 + n_azimuth - 1] = series[r0 - j0:].T
     return RotorWind(t, hub, reduced[0], reduced[1], reduced[2], polar, radii, psi, meta)
+
+
+def constrain_to_hub(wind: RotorWind, t: np.ndarray, hub: np.ndarray, *, ramp: float = 20.0) -> RotorWind:
+    """A synthesised rotor field conditioned on a measured hub-height wind (a constrained realisation).
+
+    Given a hub series ``h(t)`` (a nacelle anemometer, a met mast at hub height, OpenFAST's ``Wind1VelX``), the
+    rest of the field is drawn from the IEC model *given* ``h``: the Hoffman-Ribak construction
+    ``u_j <- u_j + K_j * (h - u_hub)`` with ``u`` an unconstrained draw (``wind``) and ``K_j`` the regression
+    of point ``j`` on the hub, which for the model of :func:`synthesize_rotor_wind` is the zero-phase filter
+    ``K_j(f) = Coh(r_j, f) = exp(-a(f) r_j)`` (the IEC coherence at the point's distance ``r_j`` from the hub;
+    cross-spectrum over the hub's spectrum). For jointly Gaussian fields ``u_j - K_j * u_hub`` is independent of
+    ``u_hub``, so the result is an exact draw of the field conditioned on the measured hub series: the hub point
+    is ``h``, a point at distance r keeps ``S (1 - Coh^2)`` of its spectrum as fresh randomness (the seed), and
+    where ``h`` is itself a draw of the model the field's statistics are those of an unconstrained field. This is
+    the idea of TurbSim's user time-series constraint, here only at the hub. Use it to repeat a measured wind's
+    slow gusts (which a single 10-minute draw of the spectrum meets only by chance) while the rotor-plane
+    structure stays random.
+
+    The constraint is radial, so the disc's linear gradients (``shear_y``, ``shear_z``) are unchanged and the disc
+    mean gains the area-weighted ring average of the corrections. Only the fluctuation of ``h`` is used: its mean
+    is replaced by the field's hub mean (the load case's wind speed; give the series' mean as the case's wind).
+    Outside the measured span the correction fades in (before) and out (after) over ``ramp`` seconds with a
+    raised cosine, so a simulation's start-up can run unconstrained into the measured window.
+
+    Parameters
+    ----------
+    wind : RotorWind
+        An unconstrained draw with its polar field (``synthesize_rotor_wind(..., return_field=True)``) and a
+        mean speed > 0.
+    t : array_like, shape (m,)
+        Times (s) of the hub series on the field's time axis (``wind.t``), strictly increasing, m >= 2.
+    hub : array_like, shape (m,)
+        Hub-height streamwise wind (m/s), finite.
+    ramp : float, default 20
+        Length (s) of the fade-in before ``t[0]`` and fade-out after ``t[-1]``, >= 0.
+
+    Returns
+    -------
+    RotorWind
+        The constrained field; ``meta["constrained_to_hub"]`` records the span, the ramp and the series' mean.
+
+    Raises
+    ------
+    ValueError
+        A field without its polar grid or mean wind, or a bad series (the message names it).
+
+    Examples
+    --------
+    >>> w = synthesize_rotor_wind(12.0, 0.17, duration=120.0, dt=0.05, seed=1)
+    >>> t = np.arange(0.0, 100.0, 0.05)
+    >>> h = 12.0 + np.sin(2 * np.pi * 0.02 * t)
+    >>> c = constrain_to_hub(w, t, h, ramp=10.0)
+    >>> bool(np.allclose(c.hub[:2000], h, atol=1e-9)), bool(np.array_equal(c.shear_y, w.shear_y))
+    (True, True)
+    """
+    if wind.polar_u is None:
+        raise ValueError("wind must carry its polar field: synthesize_rotor_wind(..., return_field=True)")
+    v = float(wind.meta.get("mean_speed", 0.0))
+    if not v > 0.0:
+        raise ValueError("wind must have a mean speed > 0 m/s to be constrained to a hub series")
+    tm = np.asarray(t, dtype=float)
+    hm = np.asarray(hub, dtype=float)
+    if tm.ndim != 1 or hm.shape != tm.shape or tm.size < 2:
+        raise ValueError(f"t and hub must be 1-D arrays of the same length >= 2, got shapes {tm.shape} and {hm.shape}")
+    if not (np.all(np.isfinite(tm)) and np.all(np.isfinite(hm))):
+        raise ValueError("t and hub must be finite (fill or cut the gaps of a measured series first)")
+    if np.any(np.diff(tm) <= 0):
+        raise ValueError("t must be strictly increasing")
+    ramp = check_number("ramp", ramp, nonneg=True)
+    tf = wind.t
+    n = tf.size
+    dt = float(tf[1] - tf[0]) if n > 1 else 1.0
+    target = v + np.interp(tf, tm, hm - hm.mean())  # the profile's hub value plus the measured fluctuation
+    weight = np.ones(n)
+    if ramp > 0.0:
+        before, after = (tm[0] - tf) / ramp, (tf - tm[-1]) / ramp
+        weight = np.where(before > 0.0, 0.5 + 0.5 * np.cos(np.pi * np.clip(before, 0.0, 1.0)), weight)
+        weight = np.where(after > 0.0, 0.5 + 0.5 * np.cos(np.pi * np.clip(after, 0.0, 1.0)), weight)
+    else:
+        weight[(tf < tm[0]) | (tf > tm[-1])] = 0.0
+    residual = weight * (target - wind.hub)
+    n_fft = next_fast_len(2 * n, real=True)  # zero padding: the zero-phase filter does not wrap around
+    spectrum = rfft(residual, n_fft)
+    f = np.fft.rfftfreq(n_fft, dt)
+    hub_height = float(wind.meta.get("hub_height", 90.0))
+    decay = _coherence_decay(f, v, turbulence_length_scale(hub_height))
+    radii = np.asarray(wind.polar_radii, dtype=float)
+    corr = irfft(np.exp(-decay[None, :] * radii[:, None]) * spectrum[None, :], n_fft, axis=-1)[:, :n]
+    corr[radii == 0.0] = residual  # the hub itself: exactly the measured series
+    polar = wind.polar_u + corr.T[:, :, None].astype(np.float32)
+    w_ring = _polar_weights(radii, wind.polar_azimuth_rad.size, float(wind.meta.get("radius", radii[-1])))
+    rotor_effective = wind.rotor_effective + (w_ring @ corr) / w_ring.sum()
+    meta = {**wind.meta, "constrained_to_hub": {"t_start": float(tm[0]), "t_end": float(tm[-1]), "ramp": ramp,
+                                                "series_mean": float(hm.mean())}}
+    return RotorWind(tf.copy(), wind.hub + residual, rotor_effective, wind.shear_y.copy(), wind.shear_z.copy(),
+                     polar, wind.polar_radii, wind.polar_azimuth_rad, meta)
