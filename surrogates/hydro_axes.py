@@ -80,8 +80,11 @@ def platform_in_fixed_axes(mass: np.ndarray, stiffness: np.ndarray, added_mass: 
     Returns
     -------
     (mass, stiffness) : tuple of ndarray, shape (n, n)
-        New arrays: ``M - A + T^T A T`` and ``T^T K T`` (``T`` :func:`fixed_axes_transform` on the platform's
-        DOFs, identity on the others), blended by ``strength``.
+        New arrays: ``M - A + T^T A T`` and ``K`` with its platform block ``K_pp`` replaced by ``T^T K_pp T``
+        (``T`` :func:`fixed_axes_transform`), blended by ``strength``. The couplings of the platform with the other
+        DOFs (the weights' P-delta couplings with the tower's bending) are left as they are: turned, the roll's
+        coupling with the side-to-side bending would reach the yaw a second time beside
+        :func:`surrogates.model.tilted_yaw_gravity_stiffness` (0.31 MN/rad at 4 deg, doubled).
     """
     m = np.asarray(mass, dtype=float)
     k = np.asarray(stiffness, dtype=float)
@@ -96,9 +99,10 @@ def platform_in_fixed_axes(mass: np.ndarray, stiffness: np.ndarray, added_mass: 
     if not math.isfinite(s) or s < 0:
         raise ValueError(f"strength must be finite and >= 0, got {strength!r}")
     t6 = fixed_axes_transform(mean_pitch)
-    t = np.eye(n)
-    t[:6, :6] = t6
     m_new = m.copy()
     m_new[:6, :6] += s * (t6.T @ a @ t6 - a)
-    k_new = k + s * (t.T @ k @ t - k)
+    # the platform's own block only: the tower's couplings to the platform's rotations are the weights' (P-delta),
+    # whose pitched-yaw share surrogates.model.tilted_yaw_gravity_stiffness holds from the exact kinematics
+    k_new = k.copy()
+    k_new[:6, :6] += s * (t6.T @ k[:6, :6] @ t6 - k[:6, :6])
     return 0.5 * (m_new + m_new.T), k_new

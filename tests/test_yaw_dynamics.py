@@ -46,6 +46,16 @@ def test_yaw_inertia_gains_the_roll_added_inertia_times_sin_squared():
     assert np.allclose(m2, m2.T) and np.all(np.linalg.eigvalsh(k2[3:, 3:]) > 0)
     m0, k0 = platform_in_fixed_axes(m, k, a, theta, strength=0.0)
     assert np.array_equal(m0, m) and np.array_equal(k0, k)
+    # a 7th DOF coupled to the roll by the weights (P-delta) keeps that coupling and gains none with the yaw:
+    # the pitched yaw's share is tilted_yaw_gravity_stiffness's, from the exact kinematics, not a second copy
+    k7 = np.zeros((7, 7))
+    k7[:6, :6], k7[6, 6], k7[3, 6] = k, 2.4e6, -4.2e6
+    k7[6, 3] = k7[3, 6]
+    m7 = np.zeros((7, 7))
+    m7[:6, :6], m7[6, 6] = m, 4e5
+    _, k7b = platform_in_fixed_axes(m7, k7, a, theta)
+    assert np.array_equal(k7b[6, :], k7[6, :]) and np.array_equal(k7b[:, 6], k7[:, 6])
+    assert np.allclose(k7b[:6, :6], k2)
     with pytest.raises(ValueError, match="added_mass"):
         platform_in_fixed_axes(m, k, a[:5, :5], theta)
 
