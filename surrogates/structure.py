@@ -175,8 +175,11 @@ def _translation(shapes: TowerShapes, z_att: float, offset: np.ndarray) -> np.nd
         phi = shapes.value(z_att)[:, 0]
         t[0, list(_FA)] = phi[:2]
         t[1, list(_SS)] = phi[2:]
-        # a point off the centreline also moves with the section's rotation
-        t += -_skew(offset) @ _rotation(shapes, z_att)
+        # a point off the centreline also moves with the section's own rotation (its slope; the platform's
+        # rotations already act on the whole position p above)
+        flex = _rotation(shapes, z_att)
+        flex[:, 3:6] = 0.0
+        t += -_skew(offset) @ flex
     return t
 
 

@@ -107,6 +107,33 @@ def test_tilted_yaw_gravity_stiffness_is_the_mixed_derivative_of_the_weights_pot
     assert np.allclose(tilted_yaw_gravity_stiffness(st, 0.0), 0.0)
 
 
+def test_offset_bodies_move_as_rigid_kinematics_says():
+    """A point of the rotor-nacelle assembly at ``p`` (off the tower's centreline by ``o``) moves by ``theta x p`` for
+    the platform's small rotations ``theta`` about the reference point, and by the tower top's deflection plus the
+    section's own rotation times ``o`` for a tower mode -- rigid-body kinematics, each counted once (the offset's
+    share of the platform rotations was counted twice: the hub's pitch arm read 92.4 m for 90, its yaw arm 10 m
+    for 5, the RNA's yaw inertia 1.7e7 for 0.4e7 kg m^2)."""
+    st = surrogates.FOWTModel().structure
+    z_top = st.data.tower_top_height
+    labels = list(st.labels)
+    for b in st.bodies:
+        if b.name not in ("nacelle", "hub", "blades"):
+            continue
+        p = b.position
+        theta = np.array([3e-6, -2e-6, 4e-6])  # small: the Jacobian is the rotation's first order
+        moved = Rotation.from_rotvec(theta).apply(p) - p
+        assert b.translation[:, 3:6] @ theta == pytest.approx(moved, rel=1e-3, abs=1e-12), b.name
+        offset = p - np.array([0.0, 0.0, z_top])
+        for name in ("tower_fa_1", "tower_ss_1"):
+            j = labels.index(name)
+            top = st.point_translation(z_top)[:, j]
+            rot = st.point_rotation(z_top)[:, j]
+            assert b.translation[:, j] == pytest.approx(top + np.cross(rot, offset), abs=1e-12), (b.name, name)
+    hub = st.hub_translation
+    hub_body = next(b for b in st.bodies if b.name == "hub")
+    assert hub[0, labels.index("pitch")] == pytest.approx(hub_body.position[2], rel=1e-6)  # the thrust's arm: 90 m
+
+
 @pytest.mark.parametrize("run", ["c_op08", "c_op18"])
 def test_replayed_side_to_side_moment_in_the_wave_band_matches_openfast(run):
     """The tower-base side-to-side moment in 0.05-0.25 Hz follows the platform's yaw in OpenFAST's records
