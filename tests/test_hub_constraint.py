@@ -141,3 +141,14 @@ def test_validate_conditions_turbulent_runs_on_their_hub_wind():
     assert rep.runs[0]["load_case"]["turbulence_intensity"] == pytest.approx(0.1703, abs=1e-3)  # nominal
     free = V.validate(None, seeds=1, duration=60.0, runs=["c_op12"], constrain_wind=False)
     assert free.settings["constrain_wind"] is False and not any("conditioned" in n for n in free.notes)
+
+
+def test_cli_free_wind_switches_the_constraint_off(tmp_path):
+    import json
+
+    from fowt_env.cli import main
+
+    out = tmp_path / "v.json"
+    assert main(["validate", "--seeds", "1", "--duration", "30", "--runs", "c_op12", "--free-wind",
+                 "--json", str(out)]) == 0
+    assert json.loads(out.read_text())["settings"]["constrain_wind"] is False

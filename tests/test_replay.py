@@ -262,9 +262,10 @@ def test_bts_reader_and_field_reduction(tmp_path):
 # since the blades' in-plane force and the AeroDyn rotor table: 0.655 and 0.652 against 0.68; at 8 m/s TwHt9ALxt
 # fell from 0.49 to 0.31 with the rotor table, whose 8 m/s rotor runs 0.4 % slow, so the azimuth drifts further,
 # and to 0.24 with the blades' cyclic flap modes, which carry the rotationally sampled loads to the tower top
-# through their own dynamics: more of its variance follows the azimuth).
+# through their own dynamics: more of its variance follows the azimuth; 0.207 once the rotor-nacelle assembly's
+# offsets stopped counting twice for the platform's rotations, which moves the azimuth's drift).
 REPLAY_TARGET_CHANNELS = ("PtfmSurge", "PtfmHeave", "PtfmPitch", "TwrBsMyt", "TwHt9ALxt", "RotSpeed", "BldPitch1")
-REPLAY_KNOWN_MISSES = {(False, "c_op08_Hs2p0_Tp9", "TwHt9ALxt", "0-1 Hz"): 0.22,
+REPLAY_KNOWN_MISSES = {(False, "c_op08_Hs2p0_Tp9", "TwHt9ALxt", "0-1 Hz"): 0.19,
                        (False, "c_op12_Hs2p5_Tp10", "TwHt9ALxt", "0-1 Hz"): 0.38,
                        (False, "c_op08_Hs2p0_Tp9", "TwrBsMyt", "0-1 Hz"): 0.6,
                        (False, "c_op18_Hs4p0_Tp11", "TwHt9ALxt", "0-1 Hz"): 0.58}  # 0.599 (cyclic flap)
