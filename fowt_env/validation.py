@@ -1173,7 +1173,7 @@ def _with_measured_inputs(run: ReferenceRun, realised_ti: bool = False) -> dict[
         elevation = np.asarray(rec["Wave1Elev"], dtype=float)
         t_rec = np.asarray(rec.t, dtype=float)
         f, p = psd(elevation, 1.0 / float(np.median(np.diff(t_rec))))
-        measured_hs = 4.0 * math.sqrt(max(float(np.sum(p)) * float(f[1] - f[0]), 0.0))
+        measured_hs = 4.0 * band_std(f, p, (0.0, math.inf))
         if np.isfinite(measured_hs) and measured_hs > 0:
             case["hs_nominal"] = case.get("hs")
             case["hs"] = measured_hs
@@ -1188,10 +1188,12 @@ def _measured_hub_wind(run: ReferenceRun, case: Any) -> tuple[np.ndarray, np.nda
         return None
     if rec is None or "Wind1VelX" not in getattr(rec, "channels", ()):
         return None
-    t, u = np.asarray(rec.t, dtype=float), np.asarray(rec["Wind1VelX"], dtype=float)
-    if t.size < 2 or not (np.all(np.isfinite(u)) and np.all(np.diff(t) > 0)):
+    from surrogates.wind import hub_series
+
+    try:
+        return hub_series(rec.t, rec["Wind1VelX"])
+    except ValueError:
         return None
-    return t, u
 
 
 def _simulate_supports_initial() -> bool:

@@ -51,7 +51,7 @@ from .structure import _CYCLIC, N_DOF
 from .structure import _FLAP as FLAP
 from .validation import check_number
 from .waves import synthesize_waves
-from .wind import TURBSIM_GRID_SPACING, RotorWind, constrain_to_hub, synthesize_rotor_wind
+from .wind import TURBSIM_GRID_SPACING, RotorWind, constrain_to_hub, hub_series, synthesize_rotor_wind
 
 
 def mean_shear_z(wind_speed: float, exponent: float = 0.2, hub_height: float = 90.0, radius: float = 63.0) -> float:
@@ -963,14 +963,7 @@ def _hub_wind_series(hub_wind: object, sim: Simulator, replayed_wind: bool) -> t
         t, u = hub_wind
     else:
         raise ValueError(f"hub_wind must be a Record with Wind1VelX or a (t, u) pair, got {type(hub_wind).__name__}")
-    t = np.asarray(t, dtype=float)
-    u = np.asarray(u, dtype=float)
-    if t.ndim != 1 or u.shape != t.shape or t.size < 2:
-        raise ValueError(f"hub_wind: t and u must be 1-D of the same length >= 2, got shapes {t.shape}, {u.shape}")
-    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(u))):
-        raise ValueError("hub_wind must be finite (fill or cut the gaps of a measured series first)")
-    if np.any(np.diff(t) <= 0):
-        raise ValueError("hub_wind: t must be strictly increasing")
+    t, u = hub_series(t, u, "hub_wind (t, u)")
     return t - t[0], u
 
 
@@ -1091,7 +1084,7 @@ def simulate(
     if any(s < 0 for s in seeds):
         raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
     sim = Simulator(model, case, dt)
-    hub_series = None if hub_wind is None else _hub_wind_series(hub_wind, sim, wind is not None)
+    hub_track = None if hub_wind is None else _hub_wind_series(hub_wind, sim, wind is not None)
     n_out = int(round(duration / sim.dt))
     if n_out < 2:
         raise ValueError(f"duration={duration} s is shorter than two samples of dt={sim.dt} s")
@@ -1108,14 +1101,16 @@ def simulate(
         psi_start = math.radians(check_number("initial['Azimuth']", initial["Azimuth"]))
     x_start, ctrl_start = sim.initial_state({k: v for k, v in initial.items() if k != "Azimuth"} if initial else None)
 
+    # the hub series on the simulation's clock: its first sample at the record's first, after the transient
+    hub_sim = None if hub_track is None else (hub_track[0] + n_skip * sim.dt, hub_track[1])
+
     def run_one(forcing_seq: np.random.SeedSequence) -> np.ndarray:
         if replay:
             u_ex, vel, psi0, blade = replay_forcing(sim, n_steps, t_start, waves, wind, forcing_seq)
             if az_series is not None:
                 blade = with_measured_azimuth(blade, t_start + np.arange(n_steps + 1) * sim.dt_int, *az_series)
         else:
-            u_ex, vel, psi0, blade = sim.forcing(n_steps, forcing_seq, None if hub_series is None else
-                                                 (hub_series[0] + n_skip * sim.dt, hub_series[1]))
+            u_ex, vel, psi0, blade = sim.forcing(n_steps, forcing_seq, hub_sim)
         if psi_start is not None:
             psi0 = psi_start
         x, ctrl = x_start.copy(), ctrl_start.copy()
@@ -1156,9 +1151,9 @@ def simulate(
             "noise": bool(noise),
             "initial": dict(initial) if initial else None,
         }
-        if hub_series is not None:
-            meta["hub_wind"] = {"t_start": float(hub_series[0][0]), "t_end": float(hub_series[0][-1]),
-                                "series_mean": float(np.mean(hub_series[1]))}
+        if hub_track is not None:
+            meta["hub_wind"] = {"t_start": float(hub_track[0][0]), "t_end": float(hub_track[0][-1]),
+                                "series_mean": float(np.mean(hub_track[1]))}
         if replay:
             meta["replay"] = replay_meta(waves, wind, t_start,
                                          None if wind is None else advection_delay(sim, wind))

@@ -42,6 +42,7 @@ __all__ = [
     "WindSeries",
     "constrain_to_hub",
     "grid_interpolation_variance",
+    "hub_series",
     "iec_turbulence_intensity",
     "kaimal_spectrum",
     "rotor_averaging",
@@ -883,6 +884,26 @@ def synthesize_rotor_wind(
     return RotorWind(t, hub, reduced[0], reduced[1], reduced[2], polar, radii, psi, meta)
 
 
+def hub_series(t: object, hub: object, name: str = "t and hub") -> tuple[np.ndarray, np.ndarray]:
+    """A measured hub-height wind series, checked: ``(t, u)`` as float arrays (s, m/s).
+
+    Raises
+    ------
+    ValueError
+        Unless both are 1-D of the same length >= 2, finite, with ``t`` strictly increasing (``name`` leads the
+        message).
+    """
+    tm = np.asarray(t, dtype=float)
+    hm = np.asarray(hub, dtype=float)
+    if tm.ndim != 1 or hm.shape != tm.shape or tm.size < 2:
+        raise ValueError(f"{name} must be 1-D arrays of the same length >= 2, got shapes {tm.shape} and {hm.shape}")
+    if not (np.all(np.isfinite(tm)) and np.all(np.isfinite(hm))):
+        raise ValueError(f"{name} must be finite (fill or cut the gaps of a measured series first)")
+    if np.any(np.diff(tm) <= 0):
+        raise ValueError(f"{name}: the time axis must be strictly increasing")
+    return tm, hm
+
+
 def constrain_to_hub(wind: RotorWind, t: np.ndarray, hub: np.ndarray, *, ramp: float = 20.0) -> RotorWind:
     """A synthesised rotor field conditioned on a measured hub-height wind (a constrained realisation).
 
@@ -941,14 +962,7 @@ def constrain_to_hub(wind: RotorWind, t: np.ndarray, hub: np.ndarray, *, ramp: f
     v = float(wind.meta.get("mean_speed", 0.0))
     if not v > 0.0:
         raise ValueError("wind must have a mean speed > 0 m/s to be constrained to a hub series")
-    tm = np.asarray(t, dtype=float)
-    hm = np.asarray(hub, dtype=float)
-    if tm.ndim != 1 or hm.shape != tm.shape or tm.size < 2:
-        raise ValueError(f"t and hub must be 1-D arrays of the same length >= 2, got shapes {tm.shape} and {hm.shape}")
-    if not (np.all(np.isfinite(tm)) and np.all(np.isfinite(hm))):
-        raise ValueError("t and hub must be finite (fill or cut the gaps of a measured series first)")
-    if np.any(np.diff(tm) <= 0):
-        raise ValueError("t must be strictly increasing")
+    tm, hm = hub_series(t, hub)
     ramp = check_number("ramp", ramp, nonneg=True)
     tf = wind.t
     n = tf.size
