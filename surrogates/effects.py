@@ -58,6 +58,11 @@ EFFECTS: dict[str, Effect] = {
         Effect("rotor_asymmetry", "Rotor yaw and tilt moments and side force from the gradients of the turbulent "
                "wind over the disc (and the mean shear): what drives roll, yaw and the side-to-side tower response.",
                linear=True),
+        Effect("rotor_skew", "Advancing and retreating blades: the wind's component in the rotor plane (the shaft's "
+               "inclination under the wind, a yaw misalignment, the hub's own in-plane motion) changes each blade's "
+               "airspeed once per revolution, hence its thrust and in-plane force: the inclined rotor's yaw moment, "
+               "the yawed rotor's tilt moment and an in-plane aerodynamic force (blade-element sensitivities of the "
+               "deck's blade at the step's tip-speed ratio and pitch).", linear=True),
         Effect("tower_drag", "Aerodynamic drag of the tower (Cd = 1.0 under the power-law wind profile), "
                "quadratic in the hub-height wind.", linear=False),
         Effect("cm_kinematics", "Second-order kinematics of the platform's rotations: the centre of mass, ~78 m "

@@ -40,7 +40,7 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
-from .aero import OperatingPoint, operating_point
+from .aero import OperatingPoint, operating_point, skew_gains
 from .channels import ALL_CHANNELS, GAUGE_HEIGHTS, UNITS, tower_channels
 from .controller import DISCON
 from .drag import DragStrips, drag_strips, wave_velocity_rao, with_relative_velocity_std
@@ -422,7 +422,8 @@ class FOWTModel:
         # HydroDyn's added mass and the platform's restoring act in the fixed axes: at the mean pitch that the
         # thrust holds, the spar's own yaw is also a fixed-axes roll (surrogates.hydro_axes)
         f_static = st.gravity_load + (h_v * op.thrust + r_s * op.generator_torque_lss if op is not None else 0.0)
-        mean_pitch = float(np.linalg.solve(k, f_static)[4])
+        q_static = np.linalg.solve(k, f_static)
+        mean_pitch = float(q_static[4])
         # the weights under that pitch: the platform's own yaw y turns the tower's lateral axis by y sin(pitch) out
         # of the horizontal, so a lateral deflection d (platform axes) raises a mass m by d y sin(pitch) (ElastoDyn's
         # exact kinematics; the p_delta family of geometric stiffness)
@@ -510,6 +511,27 @@ class FOWTModel:
             cyc_gain[:] = 1.5 * op.dT_dV / 3.0 * flap.thrust_shape * r_sample * np.array([w_t, w_y])
             f_u[_CYCLIC[1], sh.start] += -s_shear * cyc_gain[1]
             f_u[_CYCLIC[0], sh.start + 1] += s_shear * cyc_gain[0]
+        # advancing and retreating blades (rotor_skew; the simulation's nonlinear rotor does the same): the wind's
+        # in-plane component up the disc, w_z = V sin(tilt - pitch of the top) less the hub's velocity up the disc,
+        # and sideways, w_y = -V yaw of the top less the hub's lateral velocity, load the hub (yaw moment and
+        # vertical force from w_z, tilt moment and side force from w_y) and the cyclic flap modes, linearised about
+        # the inclination the mean thrust holds
+        s_skew = eff["rotor_skew"]
+        if linear_rotor and s_skew:
+            theta0 = float(r_tt[1] @ q_static)
+            inc0 = theta0 - st.data.shaft_tilt_rad
+            g_t, g_m, g_f = skew_gains(lc.wind_speed, inc0)
+            share_t, share_y = cyclic_flap_aero_shares(st.data.tip_radius)[1::2]
+            per_wy = j_hub.T @ np.array([0.0, -g_f, 0.0]) + r_tt.T @ np.array([0.0, g_m, 0.0])
+            per_wz = j_hub.T @ np.array([0.0, 0.0, -g_f]) + r_tt.T @ np.array([0.0, 0.0, g_m])
+            per_wy[_CYCLIC[0]] += st.data.blade_flap.thrust_shape * share_t * g_t
+            per_wz[_CYCLIC[1]] += st.data.blade_flap.thrust_shape * share_y * g_t
+            v0, gain = lc.wind_speed, 1.5 * s_skew
+            e_up = np.cross(e_s, [0.0, 1.0, 0.0])
+            f_u[:, 0] += gain * v0 * (np.sin(inc0) - np.cos(inc0) * theta0) * per_wz
+            f_u[:, iw] += gain * np.sin(inc0) * per_wz
+            f_x[:, :N_DOF] += gain * v0 * (np.cos(inc0) * np.outer(per_wz, r_tt[1]) - np.outer(per_wy, r_tt[2]))
+            f_x[:, N_DOF:2 * N_DOF] -= gain * s_aero * (np.outer(per_wz, e_up @ j_hub) + np.outer(per_wy, j_hub[1]))
         # the rotor's aerodynamic damping of tilt and yaw: a disc turning at (pitch rate, yaw rate) meets the
         # relative-wind gradients dU/dy = +yaw rate, dU/dz = -pitch rate, loaded as any disc gradient (the
         # simulation's nonlinear rotor does the same blade by blade)

@@ -25,7 +25,7 @@ import numba
 import numpy as np
 import scipy.linalg as sla
 
-from .aero import blade_inplane_sensitivity, inplane_ring_weights, rotor_coefficients, rotor_table
+from .aero import blade_inplane_sensitivity, inplane_ring_weights, rotor_coefficients, rotor_table, skew_gains
 from .channels import ALL_CHANNELS, UNITS
 from .controller import DISCON, N_CONTROLLER_STATE, discon_step, initial_controller_state
 from .controller import PARAMS as DISCON_PARAMS
@@ -137,12 +137,14 @@ def _blade_wind_columns(wind: RotorWind, wind_speed: float) -> np.ndarray:
 # scalar parameters of the kernel, packed in one float array ``par``
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
     P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP, P_PHIT, P_VT, P_WT, \
-    P_VY, P_WY, P_FIP, P_SPINC = range(32)
-N_PAR = 32
+    P_VY, P_WY, P_FIP, P_SPINC, P_SSKEW, P_SKT, P_SKM, P_SKF = range(36)
+N_PAR = 36
 """(P_PHIT: the blade's flap mode at the thrust's centre, ``BladeFlapMode.thrust_shape``; P_VT, P_WT, P_VY, P_WY:
 :func:`surrogates.model.cyclic_flap_aero_shares`; P_FIP: the in-plane force's share of a blade's tip flap velocity,
 its gain-weighted mean of the flap shape; P_SPINC: ``c / J`` of :func:`surrogates.model.rotor_free_inertia`, how the
-rotor speed relative to the nacelle answers the nacelle's roll about the shaft.)"""
+rotor speed relative to the nacelle answers the nacelle's roll about the shaft; P_SSKEW: strength of
+``rotor_skew``; P_SKT, P_SKM, P_SKF: one blade's thrust, moment and in-plane force per m/s of tangential airspeed,
+:func:`surrogates.aero.skew_gains` at the equilibrium's inclination.)"""
 I_ACC = N_CONTROLLER_STATE
 """Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
 accelerations of the previous internal step (m/s^2, rad/s^2), which the CM kinematics (``cm_kinematics``) read."""
@@ -363,6 +365,27 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         qdyn = par[P_QAREA] * vn * abs(vn)
         thrust = qdyn * ct
         q_aero = qdyn * par[P_RADIUS] * cq
+        # advancing and retreating blades (rotor_skew): the wind's component in the rotor plane -- up the disc
+        # w_z from the shaft's inclination (tilt - pitch, nose up), sideways w_y from the top's yaw, less the hub's
+        # own in-plane velocity -- adds w_y cos(psi_b) + w_z sin(psi_b) to blade b's airspeed; with one blade's
+        # thrust, moment and in-plane force per m/s of airspeed (skew_gains, at the operating point as the other
+        # rotor-asymmetry gains), the three blades sum to 1.5x: a yaw moment from w_z, a tilt moment from w_y, an
+        # in-plane force against each, and the cyclic flap modes loaded as by any once-per-revolution thrust
+        s_skew = par[P_SSKEW]
+        if s_skew > 0.0:
+            v_y = 0.0
+            v_up = 0.0
+            for i in range(nd):
+                v_y += r_pitch[3 * nd + i] * x[nd + i]
+                v_up += r_pitch[4 * nd + i] * x[nd + i]
+            w_z = 1.5 * s_skew * (wind * math.sin(theta - par[P_TILT]) - par[P_SAERO] * v_up)
+            w_y = 1.5 * s_skew * (-wind * math.sin(yaw) - par[P_SAERO] * v_y)
+            u[hub0 + 1] += -par[P_SKF] * w_y
+            u[hub0 + 2] += -par[P_SKF] * w_z
+            u[hub0 + 4] += par[P_SKM] * w_y
+            u[hub0 + 5] += par[P_SKM] * w_z
+            u[nl0 + _CYCLIC[0]] += par[P_PHIT] * par[P_WT] * par[P_SKT] * w_y
+            u[nl0 + _CYCLIC[1]] += par[P_PHIT] * par[P_WY] * par[P_SKT] * w_z
         # rotationally sampled turbulence: each blade's wind departs from the disc mean; linear blade loads give
         # the rotor's tilt/yaw moments, in-plane force and the 3P-band thrust and torque
         # and the disc's own tilt and yaw rates: a point (y, z) of the disc moves downwind at rate_y z - rate_z y,
@@ -638,9 +661,12 @@ class Simulator:
         self.moor_g0, self.moor_jac = self._mooring_linearisation(zf)
         self.e_s = np.ascontiguousarray(st.shaft_axis, dtype=float)
         self.h_v = np.ascontiguousarray(st.shaft_axis @ st.hub_translation, dtype=float)
+        e_up = np.cross(st.shaft_axis, [0.0, 1.0, 0.0])  # up the rotor disc, normal to the shaft
         self.r_pitch = np.ascontiguousarray(np.concatenate([st.tower_top_rotation[1], st.tower_top_rotation[2],
-                                                            st.shaft_axis @ st.tower_top_rotation]),
-                                            dtype=float)  # tower-top pitch row, yaw row, then about the shaft
+                                                            st.shaft_axis @ st.tower_top_rotation,
+                                                            st.hub_translation[1], e_up @ st.hub_translation]),
+                                            dtype=float)  # tower-top pitch row, yaw row, about the shaft, then the
+        # hub's lateral and up-the-disc translation
         rt = rotor_table()
         self.rotor_grids = (np.ascontiguousarray(rt.tsr, dtype=float), np.ascontiguousarray(rt.pitch_rad, dtype=float),
                             np.ascontiguousarray(rt.ct, dtype=float), np.ascontiguousarray(rt.cq, dtype=float))
@@ -689,6 +715,7 @@ class Simulator:
             par[P_RIP] = float(np.sum(s_node * r_node) / s_node.sum()) / par[P_RS]
             par[P_FIP] = float(np.sum(s_node * d.blade_flap.shape(r_node)) / s_node.sum())
             par[P_SPINC] = rotor_free_inertia(st)[0] / st.rotor_inertia_lss
+            par[P_SSKEW] = float(eff["rotor_skew"])
         self.par = par
         self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
         par[P_SKIN] = float(eff["cm_kinematics"])
@@ -700,6 +727,10 @@ class Simulator:
         if self.case is not None and self.case.wind_speed > 0:
             self.mean_shear[1] = mean_shear_z(self.case.wind_speed)
         self.x_eq = self._equilibrium()
+        if par[P_SSKEW] > 0.0:  # the skew gains at the inclination the equilibrium holds, then its share in it
+            theta0 = float(st.tower_top_rotation[1] @ self.x_eq[:N_DOF])
+            par[P_SKT], par[P_SKM], par[P_SKF] = skew_gains(self.case.wind_speed, theta0 - d.shaft_tilt_rad)
+            self.x_eq = self._equilibrium()
 
     # ------------------------------------------------------------------------------------------ helpers
     def _mooring_linearisation(self, zf: float) -> tuple[np.ndarray, np.ndarray]:

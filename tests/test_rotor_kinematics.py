@@ -75,7 +75,8 @@ def test_initial_platform_angles_are_elastodyns():
 
 
 def test_thrust_turns_sideways_with_the_tower_top_yaw():
-    model = surrogates.FOWTModel().with_effects(rotor_1p=0.0, rotor_3p=0.0, rotor_asymmetry=0.0)
+    model = surrogates.FOWTModel().with_effects(rotor_1p=0.0, rotor_3p=0.0, rotor_asymmetry=0.0,
+                                                   rotor_skew=0.0)
     case = surrogates.operating_case(12.0, 0.0, 10.0, turbulence_intensity=0.0)
     sim = Simulator(model, case, 0.0125)
     n = 4

@@ -84,7 +84,12 @@ class Blade:
         return float(np.interp(a, p[:, 0], p[:, 1])), float(np.interp(a, p[:, 0], p[:, 2]))
 
     def tangential_force(self, i: int, v_axial: float, v_tangential: float, pitch: float) -> float:
-        """Quasi-steady BEM tangential force per unit span (N/m) at node i (Ning's one-variable residual)."""
+        """Quasi-steady BEM tangential force per unit span (N/m) at node i."""
+        return self.node_forces(i, v_axial, v_tangential, pitch)[1]
+
+    def node_forces(self, i: int, v_axial: float, v_tangential: float, pitch: float) -> tuple[float, float]:
+        """Quasi-steady BEM normal (out of plane, downwind) and tangential (along the rotation) force per unit
+        span (N/m) at node i (Ning's one-variable residual)."""
         r, c, theta = self.r[i], self.chord[i], self.twist[i] + pitch
         sigma = N_BLADES * c / (2.0 * np.pi * r)
 
@@ -115,7 +120,8 @@ class Blade:
         _, a, ap = state(phi)
         w2 = (v_axial * (1.0 - a)) ** 2 + (v_tangential * (1.0 + ap)) ** 2
         cl, cd = self.coefficients(i, phi - theta)
-        return 0.5 * RHO * w2 * c * (cl * np.sin(phi) - cd * np.cos(phi))
+        q = 0.5 * RHO * w2 * c
+        return q * (cl * np.cos(phi) + cd * np.sin(phi)), q * (cl * np.sin(phi) - cd * np.cos(phi))
 
     def sensitivity(self, wind: float, rpm: float, pitch_rad: float, step: float = 0.1) -> np.ndarray:
         """dFt/dU (N/m per m/s) at every node (root and tip nodes 0: no lift there)."""
