@@ -25,8 +25,10 @@ rotor      5      quantities evaluated per step: blade pitch (rad), generator to
 =========  =====  ===========================================================================
 
 Outputs are the 55 channels of :data:`surrogates.channels.ALL_CHANNELS` in OpenFAST units. Linear effects
-(``aero_damping``, ``gyroscopic``, ``p_delta``) live in ``A``; nonlinear ones are evaluated per step by the
-simulator and enter through the ``hub`` and ``nonlinear`` input blocks.
+(``aero_damping``, ``gyroscopic``, ``p_delta``, ``rotor_skew``: the advancing blades of the inclined or yawed
+rotor) live in ``A`` and the ``const`` and ``wind`` columns of ``B``; nonlinear ones are evaluated per step by the
+simulator and enter through the ``hub`` and ``nonlinear`` input blocks (with the nonlinear rotor, the rotor's
+linear effects are evaluated there too).
 """
 
 from __future__ import annotations
