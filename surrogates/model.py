@@ -523,13 +523,12 @@ class FOWTModel:
             theta0 = float(r_tt[1] @ q_static)
             inc0 = theta0 - st.data.shaft_tilt_rad
             g_t, g_m, g_f = skew_gains(lc.wind_speed, inc0)
-            share_t, share_y = cyclic_flap_aero_shares(st.data.tip_radius)[1::2]
             per_wy = j_hub.T @ np.array([0.0, -g_f, 0.0]) + r_tt.T @ np.array([0.0, g_m, 0.0])
             per_wz = j_hub.T @ np.array([0.0, 0.0, -g_f]) + r_tt.T @ np.array([0.0, 0.0, g_m])
-            per_wy[_CYCLIC[0]] += st.data.blade_flap.thrust_shape * share_t * g_t
-            per_wz[_CYCLIC[1]] += st.data.blade_flap.thrust_shape * share_y * g_t
+            per_wy[_CYCLIC[0]] += flap.thrust_shape * w_t * g_t
+            per_wz[_CYCLIC[1]] += flap.thrust_shape * w_y * g_t
             v0, gain = lc.wind_speed, 1.5 * s_skew
-            e_up = np.cross(e_s, [0.0, 1.0, 0.0])
+            e_up = st.disc_up
             f_u[:, 0] += gain * v0 * (np.sin(inc0) - np.cos(inc0) * theta0) * per_wz
             f_u[:, iw] += gain * np.sin(inc0) * per_wz
             f_x[:, :N_DOF] += gain * v0 * (np.cos(inc0) * np.outer(per_wz, r_tt[1]) - np.outer(per_wy, r_tt[2]))

@@ -661,10 +661,9 @@ class Simulator:
         self.moor_g0, self.moor_jac = self._mooring_linearisation(zf)
         self.e_s = np.ascontiguousarray(st.shaft_axis, dtype=float)
         self.h_v = np.ascontiguousarray(st.shaft_axis @ st.hub_translation, dtype=float)
-        e_up = np.cross(st.shaft_axis, [0.0, 1.0, 0.0])  # up the rotor disc, normal to the shaft
         self.r_pitch = np.ascontiguousarray(np.concatenate([st.tower_top_rotation[1], st.tower_top_rotation[2],
                                                             st.shaft_axis @ st.tower_top_rotation,
-                                                            st.hub_translation[1], e_up @ st.hub_translation]),
+                                                            st.hub_translation[1], st.disc_up @ st.hub_translation]),
                                             dtype=float)  # tower-top pitch row, yaw row, about the shaft, then the
         # hub's lateral and up-the-disc translation
         rt = rotor_table()

@@ -149,6 +149,12 @@ class Structure:
     labels: tuple[str, ...] = field(default=DOF_LABELS)
 
     # ----------------------------------------------------------------------------------------- kinematics
+    @property
+    def disc_up(self) -> np.ndarray:
+        """Unit vector (3,) up the rotor disc, normal to the shaft in the vertical plane (the direction of the
+        wind's in-plane component under a nose-up shaft)."""
+        return np.cross(self.shaft_axis, [0.0, 1.0, 0.0])
+
     def point_translation(self, z: float, offset: np.ndarray | None = None) -> np.ndarray:
         """Translation Jacobian (3, N_DOF) of a point rigidly attached to the tower centreline at height ``z``.
 
