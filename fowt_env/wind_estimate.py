@@ -6,7 +6,8 @@ wind averaged over the 126 m disc, which at the platform's slow frequencies the 
 replay of an OC3 Hywind record at 12 m/s from ``Wind1VelX`` explains about half of the platform-band surge). The
 rotor itself is a better anemometer: its thrust ``T = 1/2 rho A Ct(lambda, beta) v_rel^2``, with
 ``lambda = Omega R / v_rel``, is inverted for the wind relative to the hub ``v_rel`` at every sample (the steady
-``Ct`` table of :func:`surrogates.aero.rotor_table`), and the hub's fore-aft velocity is added back.
+``Ct`` table of :func:`surrogates.aero.rotor_table`, with the blades bent by the thrust as the model's
+``blade_deflection`` effect bends them), and the hub's fore-aft velocity is added back.
 
 Steps, per sample (SI units; the record's channels in OpenFAST units):
 
@@ -41,7 +42,7 @@ from numpy.typing import NDArray
 from scipy.signal import butter, sosfiltfilt
 
 from surrogates import Record
-from surrogates.aero import rotor_table
+from surrogates.aero import blade_deflection_table, rotor_table
 from surrogates.oc3 import GRAVITY, RHO_AIR
 from surrogates.replay import MeasuredWind
 from surrogates.structure import build_structure
@@ -65,18 +66,36 @@ def _constants() -> tuple[float, float, float, float]:
     return float(d.rotor_mass), float(d.shaft_tilt_rad), float(st.hub_position[2]), float(d.tower_length)
 
 
-def _ct(lam: NDArray[np.float64], beta: NDArray[np.float64]) -> NDArray[np.float64]:
+def _ct(lam: NDArray[np.float64], beta: NDArray[np.float64],
+        bend: NDArray[np.float64] | float = 0.0) -> NDArray[np.float64]:
     """Steady thrust coefficient at tip-speed ratios ``lam`` and pitch ``beta`` (rad), bilinear on the table's
-    uniform grid and clamped at its edges (vectorised form of :func:`surrogates.aero.rotor_coefficients`)."""
+    uniform grid and clamped at its edges (vectorised form of :func:`surrogates.aero.rotor_coefficients`); with
+    ``bend`` = (tip deflection / the bent table's)^2, that of the blades bent downwind
+    (:func:`surrogates.aero.blade_deflection_table`, the model's ``blade_deflection`` effect)."""
     tab = rotor_table()
     nl, nb = tab.tsr.size, tab.pitch_rad.size
     fl = np.clip((lam - tab.tsr[0]) / (tab.tsr[1] - tab.tsr[0]), 0.0, nl - 1.000001)
     fb = np.clip((beta - tab.pitch_rad[0]) / (tab.pitch_rad[1] - tab.pitch_rad[0]), 0.0, nb - 1.000001)
     i, j = fl.astype(int), fb.astype(int)
     wl, wb = fl - i, fb - j
-    ct = tab.ct
-    return ((1 - wl) * (1 - wb) * ct[i, j] + wl * (1 - wb) * ct[i + 1, j] + (1 - wl) * wb * ct[i, j + 1]
-            + wl * wb * ct[i + 1, j + 1])
+
+    def lookup(ct: NDArray[np.float64]) -> NDArray[np.float64]:
+        return ((1 - wl) * (1 - wb) * ct[i, j] + wl * (1 - wb) * ct[i + 1, j] + (1 - wl) * wb * ct[i, j + 1]
+                + wl * wb * ct[i + 1, j + 1])
+
+    straight = lookup(tab.ct)
+    if np.all(np.asarray(bend) == 0.0):
+        return straight
+    return straight + bend * (lookup(blade_deflection_table().ct) - straight)
+
+
+@lru_cache(maxsize=1)
+def _flap_compliance() -> tuple[float, float]:
+    """The blades' collective tip deflection per N of rotor thrust, parked (m/N), and its centrifugal stiffening
+    per (rad/s)^2 (N/m per (rad/s)^2): the model's quasi-static flap mode under the thrust at its centre."""
+    st = build_structure()
+    flap = st.data.blade_flap
+    return float(flap.thrust_shape), (float(st.stiffness[10, 10]), float(st.data.n_blades * flap.centrifugal))
 
 
 def rotor_effective_wind(record: Record, cutoff_hz: float = CUTOFF_HZ) -> MeasuredWind:
@@ -126,7 +145,13 @@ def rotor_effective_wind(record: Record, cutoff_hz: float = CUTOFF_HZ) -> Measur
     tab = rotor_table()
     area = math.pi * tab.radius**2
     v = _V_GRID[None, :]
-    curve = 0.5 * RHO_AIR * area * v**2 * _ct(omega[:, None] * tab.radius / v, np.repeat(beta[:, None], v.size, 1))
+    # the blades bend under the thrust (their quasi-static flap deflection: the thrust at its centre over the flap
+    # mode's stiffness, stiffened by the rotation), and bent blades carry less thrust at the same wind
+    shape, (k_flap, k_cent) = _flap_compliance()
+    deflection = np.clip(thrust, 0.0, None) * shape / (k_flap + k_cent * omega**2)
+    bend = ((deflection / blade_deflection_table().tip_deflection) ** 2)[:, None]
+    curve = 0.5 * RHO_AIR * area * v**2 * _ct(omega[:, None] * tab.radius / v, np.repeat(beta[:, None], v.size, 1),
+                                             bend)
     # the first grid speed whose thrust reaches the measured one, linearly interpolated (T rises with v at fixed
     # rotor speed and pitch over the operating range; clamped at the grid's ends)
     k = np.clip(np.argmax(curve >= thrust[:, None], axis=1), 1, _V_GRID.size - 1)

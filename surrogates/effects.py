@@ -63,6 +63,14 @@ EFFECTS: dict[str, Effect] = {
                "airspeed once per revolution, hence its thrust and in-plane force: the inclined rotor's yaw moment, "
                "the yawed rotor's tilt moment and an in-plane aerodynamic force (blade-element sensitivities of the "
                "deck's blade at the step's tip-speed ratio and pitch).", linear=True),
+        Effect("blade_deflection", "The blades' collective flap deflection bends them downwind at constant length "
+               "(coned, turned by their slope, shorter in radius): the rotor's thrust and torque coefficients fall "
+               "with the square of the tip deflection, by 2-3 % and 3-4 % at rated's 5 m (AeroDyn on the deck's bent "
+               "blade); OpenFAST's flexible rotor pitches 1 deg less than its rigid one at rated.", linear=False),
+        Effect("sampled_wind_curvature", "Each blade meets its own wind (the shear and the turbulence over the disc), "
+               "and its thrust and torque are curved in it: the rotor carries the second-order share "
+               "1/6 d2(load)/dV2 sum_b dv_b^2 beyond the linear blade loads (convex torque: a sheared or turbulent "
+               "wind gives more power than its disc mean).", linear=False),
         Effect("tower_drag", "Aerodynamic drag of the tower (Cd = 1.0 under the power-law wind profile), "
                "quadratic in the hub-height wind.", linear=False),
         Effect("cm_kinematics", "Second-order kinematics of the platform's rotations: the centre of mass, ~78 m "

@@ -25,7 +25,14 @@ import numba
 import numpy as np
 import scipy.linalg as sla
 
-from .aero import blade_inplane_sensitivity, inplane_ring_weights, rotor_coefficients, rotor_table, skew_gains
+from .aero import (
+    blade_deflection_table,
+    blade_inplane_sensitivity,
+    inplane_ring_weights,
+    rotor_coefficients,
+    rotor_table,
+    skew_gains,
+)
 from .channels import ALL_CHANNELS, UNITS
 from .controller import DISCON, N_CONTROLLER_STATE, discon_step, initial_controller_state
 from .controller import PARAMS as DISCON_PARAMS
@@ -137,18 +144,23 @@ def _blade_wind_columns(wind: RotorWind, wind_speed: float) -> np.ndarray:
 # scalar parameters of the kernel, packed in one float array ``par``
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
     P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP, P_PHIT, P_VT, P_WT, \
-    P_VY, P_WY, P_FIP, P_SPINC, P_SSKEW, P_SKT, P_SKM, P_SKF = range(36)
-N_PAR = 36
+    P_VY, P_WY, P_FIP, P_SPINC, P_SSKEW, P_SKT, P_SKM, P_SKF, P_SBEND, P_DBEND, P_SCURV = range(39)
+N_PAR = 39
 """(P_PHIT: the blade's flap mode at the thrust's centre, ``BladeFlapMode.thrust_shape``; P_VT, P_WT, P_VY, P_WY:
 :func:`surrogates.model.cyclic_flap_aero_shares`; P_FIP: the in-plane force's share of a blade's tip flap velocity,
 its gain-weighted mean of the flap shape; P_SPINC: ``c / J`` of :func:`surrogates.model.rotor_free_inertia`, how the
 rotor speed relative to the nacelle answers the nacelle's roll about the shaft; P_SSKEW: strength of
 ``rotor_skew``; P_SKT, P_SKM, P_SKF: one blade's thrust, moment and in-plane force per m/s of tangential airspeed,
-:func:`surrogates.aero.skew_gains` at the equilibrium's inclination.)"""
+:func:`surrogates.aero.skew_gains` at the equilibrium's inclination; P_SBEND, P_DBEND: strength of
+``blade_deflection`` and the tip deflection (m) of :func:`surrogates.aero.blade_deflection_table`'s bent blades;
+P_SCURV: strength of ``sampled_wind_curvature``.)"""
 I_ACC = N_CONTROLLER_STATE
 """Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
 accelerations of the previous internal step (m/s^2, rad/s^2), which the CM kinematics (``cm_kinematics``) read."""
 N_CARRIED = N_CONTROLLER_STATE + 3
+H_CURV = 1.0
+"""Wind step (m/s) of the second differences that give the rotor's curvature in the wind (sampled_wind_curvature):
+two rotor-table cells of tip-speed ratio at rated (0.5 apart), so that the bilinear table's kinks average out."""
 FIELD_DT = 0.05
 """Time step (s) of the synthesised turbulent field over the rotor disc."""
 N_BLADE_AZIMUTH = 24
@@ -283,7 +295,8 @@ def _mooring_generalised(x, gx, gy, gyaw, tab, zf, out):
 @numba.njit(cache=True, nogil=True)
 def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_along, drag_across, drag_dir, moor_gx,
            moor_gy, moor_gyaw, moor_tab, moor_g0,
-           moor_jac, moor_out, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab, cq_tab, par, u):
+           moor_jac, moor_out, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab, cq_tab, ctb_tab, cqb_tab, par,
+           u):
     """Fill u[10:] (actions, hub loads, nonlinear generalised forces, rotor outputs) from the state at the start
     of a step; return the rotor acceleration (rad/s^2, 0 when the rotor is linear or parked)."""
     nd = N_DOF
@@ -362,9 +375,40 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         pitch = ctrl[2] + action[0]
         lam = omega * par[P_RADIUS] / max(abs(vn), 0.1)
         ct, cq = rotor_coefficients(tsr_grid, pitch_grid, ct_tab, cq_tab, lam, pitch)
+        # the blades bent downwind by their collective flap deflection (blade_deflection): quadratic in the tip
+        # deflection between the straight rotor and the tabulated bent one
+        f_bend = 0.0
+        if par[P_SBEND] > 0.0:
+            f_bend = x[FLAP] / par[P_DBEND]
+            f_bend = par[P_SBEND] * f_bend * f_bend
+            ctb, cqb = rotor_coefficients(tsr_grid, pitch_grid, ctb_tab, cqb_tab, lam, pitch)
+            ct += f_bend * (ctb - ct)
+            cq += f_bend * (cqb - cq)
         qdyn = par[P_QAREA] * vn * abs(vn)
         thrust = qdyn * ct
         q_aero = qdyn * par[P_RADIUS] * cq
+        # curvature of the rotor's thrust and torque in a uniform wind at this step's speed and pitch (second
+        # differences over +-H_CURV m/s): each blade meets its own wind, and a blade's load is curved in it
+        # (sampled_wind_curvature), so the rotor carries 1/3 * 1/2 * d2(load)/dV2 * dv_b^2 per blade beyond the
+        # linear blade loads
+        t_uu = 0.0
+        q_uu = 0.0
+        s_curv = par[P_SCURV]
+        if s_curv > 0.0:
+            for sgn in (-1.0, 1.0):
+                v_c = vn + sgn * H_CURV
+                ct_c, cq_c = rotor_coefficients(tsr_grid, pitch_grid, ct_tab, cq_tab,
+                                                omega * par[P_RADIUS] / max(abs(v_c), 0.1), pitch)
+                if f_bend > 0.0:
+                    ctb, cqb = rotor_coefficients(tsr_grid, pitch_grid, ctb_tab, cqb_tab,
+                                                  omega * par[P_RADIUS] / max(abs(v_c), 0.1), pitch)
+                    ct_c += f_bend * (ctb - ct_c)
+                    cq_c += f_bend * (cqb - cq_c)
+                q_c = par[P_QAREA] * v_c * abs(v_c)
+                t_uu += q_c * ct_c
+                q_uu += q_c * par[P_RADIUS] * cq_c
+            t_uu = s_curv * (t_uu - 2.0 * thrust) / (H_CURV * H_CURV) / 6.0
+            q_uu = s_curv * (q_uu - 2.0 * q_aero) / (H_CURV * H_CURV) / 6.0
         # advancing and retreating blades (rotor_skew): the wind's component in the rotor plane -- up the disc
         # w_z from the shaft's inclination (tilt - pitch, nose up), sideways w_y from the top's yaw, less the hub's
         # own in-plane velocity -- adds w_y cos(psi_b) + w_z sin(psi_b) to blade b's airspeed; with one blade's
@@ -434,8 +478,10 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                     dv_ip = dv_r
                 d_t = par[P_DTDU] / 3.0 * dv
                 d_q = par[P_DQDU] / 3.0 * dv
-                thrust += d_t
-                q_aero += d_q
+                # the curvature's share goes to the collective thrust and torque only: its once-per-revolution
+                # part, summed over the blades, is the shear's 3P tilt and yaw, which the measured harmonics hold
+                thrust += d_t + t_uu * dv * dv
+                q_aero += d_q + q_uu * dv * dv
                 # blade at (y, z) = r (-sin, cos): tilt = z F, yaw = -y F (its own lever: see ROTOR_ASYMMETRY); the
                 # cyclic flap modes take the thrust at the thrust's centre (their response lags it: cyclic_flap_lag)
                 mt += d_t * par[P_RT] * c_b
@@ -512,7 +558,7 @@ def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, v
              drag_along,
              drag_across, drag_dir, moor_gx,
              moor_gy, moor_gyaw, moor_tab, moor_g0, moor_jac, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab,
-             cq_tab, discon, par, x_hist, u_hist, out0):
+             cq_tab, ctb_tab, cqb_tab, discon, par, x_hist, u_hist, out0):
     """Advance ``n_steps`` internal steps from step index ``k0``.
 
     ``exo[k]`` is the precomputed contribution of the exogenous inputs to ``x[k+1]``; ``u_ex[k]`` the exogenous
@@ -540,7 +586,7 @@ def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, v
                         drag_dir,
                         moor_gx, moor_gy, moor_gyaw,
                         moor_tab, moor_g0, moor_jac, moor_out, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab,
-                        cq_tab, par, u)
+                        cq_tab, ctb_tab, cqb_tab, par, u)
         if step % every == 0:
             row = out0 + n_out
             for i in range(n_x):
@@ -667,8 +713,10 @@ class Simulator:
                                             dtype=float)  # tower-top pitch row, yaw row, about the shaft, then the
         # hub's lateral and up-the-disc translation
         rt = rotor_table()
+        bent = blade_deflection_table()
         self.rotor_grids = (np.ascontiguousarray(rt.tsr, dtype=float), np.ascontiguousarray(rt.pitch_rad, dtype=float),
-                            np.ascontiguousarray(rt.ct, dtype=float), np.ascontiguousarray(rt.cq, dtype=float))
+                            np.ascontiguousarray(rt.ct, dtype=float), np.ascontiguousarray(rt.cq, dtype=float),
+                            np.ascontiguousarray(bent.ct, dtype=float), np.ascontiguousarray(bent.cq, dtype=float))
         h = model.harmonics
         op = self.system.op
         s3, s1 = eff["rotor_3p"], eff["rotor_1p"]
@@ -715,6 +763,10 @@ class Simulator:
             par[P_FIP] = float(np.sum(s_node * d.blade_flap.shape(r_node)) / s_node.sum())
             par[P_SPINC] = rotor_free_inertia(st)[0] / st.rotor_inertia_lss
             par[P_SSKEW] = float(eff["rotor_skew"])
+            par[P_SCURV] = float(eff["sampled_wind_curvature"])
+        if op is not None and self.nonlinear_rotor:
+            par[P_SBEND] = float(eff["blade_deflection"])
+            par[P_DBEND] = bent.tip_deflection
         self.par = par
         self.discon = np.ascontiguousarray(DISCON_PARAMS, dtype=float)
         par[P_SKIN] = float(eff["cm_kinematics"])

@@ -175,6 +175,50 @@ def aerodyn_copy(ad_path: Path, overrides: dict[str, str] | None = None) -> tupl
     return text, settings
 
 
+def flap_mode_shape(ed_path: Path) -> np.ndarray:
+    """Coefficients of ``x^2 .. x^6`` of the blade's first flap mode in the ElastoDyn blade file the ElastoDyn
+    input names (``BldFile(1)``, ``BldFl1Sh(2..6)``; x = span fraction from the root, shape 1 at the tip)."""
+    text = ed_path.read_text()
+    rel = _value(text, "BldFile(1)").strip('"')
+    blade = (ed_path.parent / rel).resolve()
+    bt = blade.read_text()
+    return np.array([float(_value(bt, f"BldFl1Sh({k})")) for k in range(2, 7)])
+
+
+def deflected_blade(ad_blade: Path, coeffs: np.ndarray, tip_deflection: float, out: Path) -> Path:
+    """The AeroDyn blade file with the blade bent downwind along its first flap mode (tip ``tip_deflection`` m):
+    each node's out-of-plane offset ``BlCrvAC`` gains ``delta phi(x)``, its cant ``BlCrvAng`` the slope
+    ``atan(delta phi'(x) / L)`` (deg), and its span ``BlSpn`` loses the foreshortening of the bent blade
+    ``1/2 int_0^r (delta phi'/L)^2 dr`` (a beam bends at constant length, as ElastoDyn's blades do:
+    its ``AxRedBld``), L the blade length (the last node's span)."""
+    lines = ad_blade.read_text().splitlines()
+    rows = [i for i, ln in enumerate(lines) if len(ln.split()) == 7 and _is_numbers(ln.split())]
+    span = np.array([float(lines[i].split()[0]) for i in rows])
+    length = span[-1]
+
+    def slope(x: np.ndarray) -> np.ndarray:  # d(delta phi)/dr
+        return tip_deflection * sum(c * (k + 2) * x ** (k + 1) for k, c in enumerate(coeffs)) / length
+
+    for i, r in zip(rows, span, strict=True):
+        v = [float(t) for t in lines[i].split()]
+        x = r / length
+        xs = np.linspace(0.0, x, 401)
+        v[0] = r - 0.5 * float(np.trapezoid(slope(xs) ** 2, xs * length))
+        v[1] += tip_deflection * sum(c * x ** (k + 2) for k, c in enumerate(coeffs))
+        v[3] += math.degrees(math.atan(float(slope(np.array(x)))))
+        lines[i] = "  ".join(f"{a: .7E}" for a in v[:6]) + f"  {int(v[6])}"
+    out.write_text("\n".join(lines) + "\n")
+    return out
+
+
+def _is_numbers(tokens: list[str]) -> bool:
+    try:
+        [float(t) for t in tokens]
+    except ValueError:
+        return False
+    return True
+
+
 def driver_text(ad_file: str, geo: dict, env: dict, tilt_deg: float, cases: list[tuple]) -> str:
     """AeroDyn driver input: basic HAWT with the deck's geometry, combined cases (V, PLExp, rpm, pitch, dt, tmax)."""
     tilt = math.radians(tilt_deg)  # upwind end of the shaft up (OpenFAST's ShftTilt = -tilt_deg)
@@ -341,14 +385,20 @@ def overrides(args) -> dict[str, str]:
 
 def settings_key(args, deck_sha: str, driver_sha: str) -> dict:
     return dict(overrides=overrides(args), tilt=args.tilt, shear=args.shear, rpm=args.rpm, revs=args.revs,
-                deck=deck_sha, driver=driver_sha)
+                deck=deck_sha, driver=driver_sha, flap_deflection=args.flap_deflection)
 
 
 def run_grid(args, inp: dict, tsr: np.ndarray, pitch: np.ndarray) -> tuple[list[dict], float]:
     driver = Path(args.driver).resolve()
-    ad_text, _ = aerodyn_copy(inp["ad"], overrides(args))
     work = Path(args.workdir) if args.workdir else Path(tempfile.mkdtemp(prefix="aerodyn_rotor_table_"))
     work.mkdir(parents=True, exist_ok=True)
+    changed = overrides(args)
+    if args.flap_deflection:
+        ad_blade = (inp["ad"].parent / _value(inp["ad"].read_text(), "ADBlFile(1)").strip('"')).resolve()
+        bent = deflected_blade(ad_blade, flap_mode_shape(inp["ed"]), args.flap_deflection,
+                               work / f"blade_flap{args.flap_deflection:g}m.dat")
+        changed.update({f"ADBlFile({i})": f'"{bent}"' for i in (1, 2, 3)})
+    ad_text, _ = aerodyn_copy(inp["ad"], changed)
     key = settings_key(args, sha256(inp["ad"]), sha256(driver))
     rows = []
     t0 = time.time()
@@ -426,6 +476,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="override an AeroDyn input, e.g. TwrPotent=0 (checks only; repeatable)")
     ap.add_argument("--tilt", type=float, default=0.0, help="shaft tilt, deg, upwind end up (default 0)")
     ap.add_argument("--shear", type=float, default=0.0, help="power-law shear exponent (default 0)")
+    ap.add_argument("--flap-deflection", type=float, default=0.0, metavar="M",
+                    help="blades bent downwind along their first flap mode, tip deflection M metres, at constant "
+                         "length (default 0: the deck's straight blades)")
     ap.add_argument("--rpm", type=float, default=12.0, help="rotor speed (default 12: 400 steps per revolution)")
     ap.add_argument("--revs", type=int, default=3, help="revolutions per point; the last one is averaged")
     ap.add_argument("--compare", action="store_true", help="print ratios to ROSCO's table at the grid points")
@@ -490,7 +543,8 @@ def main(argv: list[str] | None = None) -> int:
         f"AIDrag {settings['AIDrag']}, TIDrag {settings['TIDrag']}, DBEMT_Mod {settings['DBEMT_Mod']}, "
         f"AFTabMod {settings['AFTabMod']}, AoA34 {settings['AoA34']}, UseBlCm {settings['UseBlCm']}",
         f"Inflow: steady, uniform (shear exponent {args.shear:g}), aligned with the shaft (tilt {args.tilt:g} deg, "
-        "yaw 0); rigid blades;",
+        "yaw 0); " + (f"blades bent downwind along their first flap mode, tip {args.flap_deflection:g} m, at "
+                      "constant length;" if args.flap_deflection else "rigid blades;"),
         f"  precone {geo['PreCone(1)']:g} deg, hub radius {geo['HubRad']:g} m, tip radius {geo['TipRad']:g} m, "
         f"overhang {geo['OverHang']:g} m, tower top {geo['TowerHt']:g} m (AeroDyn tower)",
         f"Each point: {args.rpm:g} rpm, V = Omega R / lambda, DT {inp['env']['DT']:g} s, {args.revs} revolutions "
