@@ -487,19 +487,20 @@ class BladeDeflectionTable:
     A blade bent by its flap deflection is coned downwind, turned by its slope and shorter in radius (it bends at
     constant length): it meets less of the wind and sweeps a smaller disc. OpenFAST's AeroDyn driver on the deck's
     blade bent along its first flap mode (ElastoDyn's ``BldFl1Sh``) with a tip deflection ``tip_deflection``
-    (``tools/blade_deflection_table.py``) gives the change from the straight blades' coefficients (at the deck's
-    5 deg shaft tilt, on a coarser grid, interpolated bilinearly); here it is added to :func:`rotor_table`.
-    Between the straight and the tabulated blade the coefficients are taken quadratic in the tip deflection ``d``
-    (the cone, slope and shortening effects all are, to leading order)::
+    (``tools/blade_deflection_table.py``) gives the change from the straight blades' coefficients, at the deck's
+    operating conditions near rated (the shaft inclined 9 deg, shear 0.2: the bent blades lose more there than in
+    an aligned uniform wind, 3.2 % of the torque against 2.4 % at rated pitch), on a coarser grid interpolated
+    bilinearly; here it is added to :func:`rotor_table`. Between the straight and the tabulated blade the
+    coefficients are taken quadratic in the tip deflection ``d`` (the cone, slope and shortening effects all are,
+    to leading order)::
 
         C(d) = C + (C_bent - C) (d / tip_deflection)^2
 
     Measured on the deck (``tools/openfast_blade_flex_runs.py``, platform held, steady 12 m/s): in uniform wind
     OpenFAST's rotor settles 0.455 deg of pitch lower with flexible blades (4.7 m at the tip) than with rigid ones,
-    and this table gives 0.373 deg; at the steady-wind run's mean position (shear 0.2, 10.3 deg inclination) the
-    difference is 1.05 deg (5.26 m), where AeroDyn's driver with the bent blade in that shear and inclination gives
-    0.78 deg and this table, of uniform wind at 5 deg tilt, less (the bent blades lose 3.2 % of their torque there,
-    2.4 % in uniform wind).
+    and this table gives 0.471 deg; at the steady-wind run's mean position (shear 0.2, 10.3 deg inclination)
+    the difference is 1.05 deg (5.26 m) and the simulation's rotor gives 0.80 deg
+    (``tests/test_blade_deflection.py``).
 
     Attributes
     ----------

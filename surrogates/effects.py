@@ -65,8 +65,8 @@ EFFECTS: dict[str, Effect] = {
                "deck's blade at the step's tip-speed ratio and pitch).", linear=True),
         Effect("blade_deflection", "The blades' collective flap deflection bends them downwind at constant length "
                "(coned, turned by their slope, shorter in radius): the rotor's thrust and torque coefficients fall "
-               "with the square of the tip deflection, by 2-3 % and 3-4 % at rated's 5 m (AeroDyn on the deck's bent "
-               "blade); OpenFAST's flexible rotor pitches 1 deg less than its rigid one at rated.", linear=False),
+               "with the square of the tip deflection, by ~2 % and ~3 % at rated's 5 m (AeroDyn on the deck's bent "
+               "blade); OpenFAST's flexible rotor pitches 0.5-1 deg less than its rigid one at rated.", linear=False),
         Effect("sampled_wind_curvature", "Each blade meets its own wind (the shear and the turbulence over the disc), "
                "and its thrust and torque are curved in it: the rotor carries the second-order share "
                "1/6 d2(load)/dV2 sum_b dv_b^2 beyond the linear blade loads (convex torque: a sheared or turbulent "
