@@ -15,9 +15,10 @@ Analysis tool (not imported by the package). Usage::
 the working folder for the truth records and ``results.json`` (default a temporary folder). About 30-60 s per truth
 seed on two cores.
 
-Measured on the physics of the advancing blades, ``rotor_skew`` (16 truth seeds, 1000-1015, ~170 graded checks per
-folder): with the hub-wind constraint 6.75 failures on average (median 7, range 0-16), without it 7.2 (median 7,
-range 0-26; before ``rotor_skew`` 6.5 and 6.75); the
+Measured on the physics of the flexible blades, ``blade_deflection`` and ``sampled_wind_curvature`` (16 truth
+seeds, 1000-1015, ~170 graded checks per folder): with the hub-wind constraint 7.4 failures on average (median 7,
+range 0-17), without it 7.9 (median 7, range 1-24; with ``rotor_skew`` alone 6.75 and 7.2, before it 6.5 and 6.75);
+the
 slow band (< 0.05 Hz) and the total standard deviations carry most of them, in both directions.
 """
 
