@@ -90,12 +90,14 @@ def _ct(lam: NDArray[np.float64], beta: NDArray[np.float64],
 
 
 @lru_cache(maxsize=1)
-def _flap_compliance() -> tuple[float, float]:
-    """The blades' collective tip deflection per N of rotor thrust, parked (m/N), and its centrifugal stiffening
-    per (rad/s)^2 (N/m per (rad/s)^2): the model's quasi-static flap mode under the thrust at its centre."""
+def _flap_compliance() -> tuple[float, tuple[float, float]]:
+    """The model's collective flap mode under the rotor thrust: the mode's value at the thrust's centre (-, the
+    share of the thrust it takes), and its stiffness parked (N/m) and centrifugal stiffening per (rad/s)^2, so
+    that the quasi-static tip deflection is ``T shape / (k + k_cent Omega^2)`` (m)."""
     st = build_structure()
     flap = st.data.blade_flap
-    return float(flap.thrust_shape), (float(st.stiffness[10, 10]), float(st.data.n_blades * flap.centrifugal))
+    i = st.labels.index("blade_flap")
+    return float(flap.thrust_shape), (float(st.stiffness[i, i]), float(st.data.n_blades * flap.centrifugal))
 
 
 def rotor_effective_wind(record: Record, cutoff_hz: float = CUTOFF_HZ) -> MeasuredWind:

@@ -397,11 +397,10 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         if s_curv > 0.0:
             for sgn in (-1.0, 1.0):
                 v_c = vn + sgn * H_CURV
-                ct_c, cq_c = rotor_coefficients(tsr_grid, pitch_grid, ct_tab, cq_tab,
-                                                omega * par[P_RADIUS] / max(abs(v_c), 0.1), pitch)
+                lam_c = omega * par[P_RADIUS] / max(abs(v_c), 0.1)
+                ct_c, cq_c = rotor_coefficients(tsr_grid, pitch_grid, ct_tab, cq_tab, lam_c, pitch)
                 if f_bend > 0.0:
-                    ctb, cqb = rotor_coefficients(tsr_grid, pitch_grid, ctb_tab, cqb_tab,
-                                                  omega * par[P_RADIUS] / max(abs(v_c), 0.1), pitch)
+                    ctb, cqb = rotor_coefficients(tsr_grid, pitch_grid, ctb_tab, cqb_tab, lam_c, pitch)
                     ct_c += f_bend * (ctb - ct_c)
                     cq_c += f_bend * (cqb - cq_c)
                 q_c = par[P_QAREA] * v_c * abs(v_c)

@@ -55,7 +55,10 @@ def _kernel_pitch(model: surrogates.FOWTModel, run: dict, deflection: float) -> 
     case = surrogates.load_case(7).replace(wind_speed=12.0, turbulence_intensity=0.0, hs=0.0)
     sim = SIM.Simulator(model, case, 0.0125)
     x = sim.x_eq.copy()
-    x[0], x[4], x[10] = run["surge"], np.deg2rad(run["pitch"]), deflection
+    labels = model.structure.labels
+    x[labels.index("surge")] = run["surge"]
+    x[labels.index("pitch")] = np.deg2rad(run["pitch"])
+    x[labels.index("blade_flap")] = deflection
     u_ex = np.zeros((1, SIM.N_EX))
     u_ex[0, 0] = 1.0
     u_ex[0, SIM.INPUT_BLOCKS["hub_wind"].start] = 12.0

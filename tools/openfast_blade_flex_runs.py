@@ -37,6 +37,7 @@ import argparse
 import concurrent.futures
 import datetime
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -108,7 +109,7 @@ def run_one(openfast: str, folder: Path, reuse: bool) -> Path:
     if reuse and out.exists():
         return out
     proc = subprocess.run([openfast, f"{BASE_RUN}.fst"], cwd=folder, capture_output=True, text=True,
-                          env={"OPENBLAS_NUM_THREADS": "1", "PATH": "/usr/bin:/bin"})
+                          env={**os.environ, "OPENBLAS_NUM_THREADS": "1"})
     (folder / "run.log").write_text(proc.stdout + proc.stderr)
     if proc.returncode != 0 or not out.exists():
         raise RuntimeError(f"OpenFAST failed in {folder} (see run.log)")
