@@ -480,6 +480,56 @@ def skew_gains(wind_speed: float, inclination_rad: float) -> tuple[float, float,
     return blade_skew_table().sensitivities(v, op.rotor_speed, op.pitch)
 
 
+@lru_cache(maxsize=1)
+def _inclined_rotor_data() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    import json
+
+    data = json.loads(resources.files("surrogates").joinpath("data/inclined_rotor_inplane.json").read_text())
+    return tuple(np.asarray(data[k], dtype=float) for k in ("wind_speed", "eps_straight", "eps_per_m"))
+
+
+def inclined_rotor_inplane(wind_speed: float) -> tuple[float, float]:
+    """How the inclined (or yawed) rotor's blades meet its in-plane wind in their in-plane force (-, 1/m).
+
+    The wind's component in the rotor plane ``W`` (up the disc ``V sin(inclination)`` when the shaft is inclined
+    nose up by its tilt and the platform's pitch; sideways when the rotor is yawed; less the hub's own in-plane
+    velocity) is met differently by a blade on the side it blows towards and one on the other side: a blade coned
+    downwind (its flap deflection, less the deck's 2.5 deg of upwind precone) takes part of ``W`` as axial wind,
+    and AeroDyn's skewed-wake model (Pitt and Peters) raises the induction on the side ``W`` blows towards. Each
+    blade's in-plane force then sees its axial wind change by ``-eps (W . e_r)`` (``e_r`` its radial direction),
+    ``eps = eps_straight + eps_per_m * d`` for blades bent ``d`` m at the tip, and three blades give the in-plane
+    force ``1.5 G eps W`` (``G`` one blade's gain of :func:`blade_inplane_sensitivity`): a side force that takes
+    back part of the shear's.
+
+    Measured with OpenFAST's AeroDyn driver on the deck's rotor at the steady operating points, inclined 5 and
+    10 deg, straight and bent 5 m (``tools/inclined_rotor_inplane_table.py``, table in ``surrogates/data``);
+    linear in the wind speed between the tabulated 4-25 m/s, held outside. Inclined 10 deg at 12 m/s, 5 m of tip
+    deflection move the side force by +2.7 kN, a fifth of the shear's (-14 kN, AeroDyn); OpenFAST's own
+    flexible rotor in the steady-wind run's conditions puts -10.1 kN on its yaw bearing where its rigid one puts
+    -19.0 kN.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Mean wind speed (m/s), > 0.
+
+    Returns
+    -------
+    (float, float)
+        ``eps_straight`` (-) and ``eps_per_m`` (1/m).
+
+    Examples
+    --------
+    >>> e0, e1 = inclined_rotor_inplane(12.0)
+    >>> bool(abs(e0) < 0.05 and 0.01 < e1 < 0.03)  # the bent blades carry most of it near rated
+    True
+    """
+    if not np.isfinite(wind_speed) or wind_speed <= 0:
+        raise ValueError(f"wind_speed must be a positive finite number (m/s), got {wind_speed!r}")
+    v, e0, e1 = _inclined_rotor_data()
+    return float(np.interp(wind_speed, v, e0)), float(np.interp(wind_speed, v, e1))
+
+
 @dataclass(frozen=True)
 class BladeDeflectionTable:
     """The rotor's thrust and torque coefficients with its blades bent downwind, on :func:`rotor_table`'s grid.

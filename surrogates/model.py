@@ -42,7 +42,7 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
-from .aero import OperatingPoint, operating_point, skew_gains
+from .aero import OperatingPoint, blade_inplane_sensitivity, inclined_rotor_inplane, operating_point, skew_gains
 from .channels import ALL_CHANNELS, GAUGE_HEIGHTS, UNITS, tower_channels
 from .controller import DISCON
 from .drag import DragStrips, drag_strips, wave_velocity_rao, with_relative_velocity_std
@@ -527,7 +527,17 @@ class FOWTModel:
             per_wz = j_hub.T @ np.array([0.0, 0.0, -g_f]) + r_tt.T @ np.array([0.0, 0.0, g_m])
             per_wy[_CYCLIC[0]] += flap.thrust_shape * w_t * g_t
             per_wz[_CYCLIC[1]] += flap.thrust_shape * w_y * g_t
+            # the coned blades and the skewed wake meet the in-plane wind as a gradient against it: each blade's
+            # in-plane force sees -eps (w . e_r), a side force from w_z and a vertical one from w_y (eps at the
+            # mean flap deflection; its change with the deflection loads the hub from the flap mode)
+            g_ip = float(blade_inplane_sensitivity(lc.wind_speed)[1].sum())
+            e0, e1 = inclined_rotor_inplane(lc.wind_speed)
+            s_bend = eff["blade_deflection"]
+            eps = e0 + s_bend * e1 * float(q_static[_FLAP])
+            per_wz += j_hub.T @ np.array([0.0, g_ip * eps, 0.0])
+            per_wy += j_hub.T @ np.array([0.0, 0.0, -g_ip * eps])
             v0, gain = lc.wind_speed, 1.5 * s_skew
+            f_x[:, _FLAP] += (gain * v0 * np.sin(inc0) * s_bend * e1 * g_ip) * (j_hub.T @ np.array([0.0, 1.0, 0.0]))
             e_up = st.disc_up
             f_u[:, 0] += gain * v0 * (np.sin(inc0) - np.cos(inc0) * theta0) * per_wz
             f_u[:, iw] += gain * np.sin(inc0) * per_wz

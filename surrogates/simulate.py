@@ -28,6 +28,7 @@ import scipy.linalg as sla
 from .aero import (
     blade_deflection_table,
     blade_inplane_sensitivity,
+    inclined_rotor_inplane,
     inplane_ring_weights,
     rotor_coefficients,
     rotor_table,
@@ -144,8 +145,9 @@ def _blade_wind_columns(wind: RotorWind, wind_speed: float) -> np.ndarray:
 # scalar parameters of the kernel, packed in one float array ``par``
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
     P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP, P_PHIT, P_VT, P_WT, \
-    P_VY, P_WY, P_FIP, P_SPINC, P_SSKEW, P_SKT, P_SKM, P_SKF, P_SBEND, P_DBEND, P_SCURV = range(39)
-N_PAR = 39
+    P_VY, P_WY, P_FIP, P_SPINC, P_SSKEW, P_SKT, P_SKM, P_SKF, P_SBEND, P_DBEND, P_SCURV, P_INCF0, \
+    P_INCF1 = range(41)
+N_PAR = 41
 """(P_PHIT: the blade's flap mode at the thrust's centre, ``BladeFlapMode.thrust_shape``; P_VT, P_WT, P_VY, P_WY:
 :func:`surrogates.model.cyclic_flap_aero_shares`; P_FIP: the in-plane force's share of a blade's tip flap velocity,
 its gain-weighted mean of the flap shape; P_SPINC: ``c / J`` of :func:`surrogates.model.rotor_free_inertia`, how the
@@ -153,7 +155,8 @@ rotor speed relative to the nacelle answers the nacelle's roll about the shaft; 
 ``rotor_skew``; P_SKT, P_SKM, P_SKF: one blade's thrust, moment and in-plane force per m/s of tangential airspeed,
 :func:`surrogates.aero.skew_gains` at the equilibrium's inclination; P_SBEND, P_DBEND: strength of
 ``blade_deflection`` and the tip deflection (m) of :func:`surrogates.aero.blade_deflection_table`'s bent blades;
-P_SCURV: strength of ``sampled_wind_curvature``.)"""
+P_SCURV: strength of ``sampled_wind_curvature``; P_INCF0, P_INCF1: the in-plane force's share of the rotor's
+in-plane wind, straight blades and per metre of tip deflection, :func:`surrogates.aero.inclined_rotor_inplane`.)"""
 I_ACC = N_CONTROLLER_STATE
 """Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
 accelerations of the previous internal step (m/s^2, rad/s^2), which the CM kinematics (``cm_kinematics``) read."""
@@ -415,6 +418,8 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         # rotor-asymmetry gains), the three blades sum to 1.5x: a yaw moment from w_z, a tilt moment from w_y, an
         # in-plane force against each, and the cyclic flap modes loaded as by any once-per-revolution thrust
         s_skew = par[P_SSKEW]
+        w_z = 0.0
+        w_y = 0.0
         if s_skew > 0.0:
             v_y = 0.0
             v_up = 0.0
@@ -439,7 +444,15 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         s_asym = par[P_SASYM]
         s_rot = par[P_SAERO] if par[P_RS] > 0.0 else 0.0
         has_field = s_asym > 0.0 and blade.shape[0] > k and blade[k, 0] == blade[k, 0]  # NaN: azimuth only
-        if has_field or s_rot > 0.0:
+        # the inclined (or yawed) rotor's in-plane wind W (the skew block's, per blade) meets the coned blades and
+        # AeroDyn's skewed wake as a gradient against it: blade b's in-plane force sees its axial wind change by
+        # -eps (W . e_r,b), eps linear in the collective flap deflection (the blades' downwind cone);
+        # inclined_rotor_inplane
+        eps_f = 0.0
+        if s_skew > 0.0:
+            eps_f = par[P_INCF0] + (par[P_SBEND] * par[P_INCF1] * x[FLAP] if par[P_SBEND] > 0.0 else 0.0)
+            eps_f *= 1.0 / 1.5  # w_y, w_z carry the three blades' 1.5 and the strength
+        if has_field or s_rot > 0.0 or eps_f != 0.0:
             it = _CYCLIC[0]
             iy = _CYCLIC[1]
             tip_t = x[nd + it] + omega * x[iy]
@@ -461,6 +474,7 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 dv = dv_r - s_rot * (flap_t * c_b + flap_y * s_b)
                 # the in-plane force meets the rates at its own mean radius and the flap at its own mean shape
                 dv_r = dv_r * par[P_RIP] - s_rot * par[P_FIP] * (tip_t * c_b + tip_y * s_b)
+                dv_r -= eps_f * (w_z * c_b - w_y * s_b)  # the in-plane wind along blade b, at (y, z) = r (-sin, cos)
                 if has_field:
                     n_az = N_BLADE_AZIMUTH
                     d_az = 2.0 * math.pi / n_az
@@ -763,6 +777,7 @@ class Simulator:
             par[P_SPINC] = rotor_free_inertia(st)[0] / st.rotor_inertia_lss
             par[P_SSKEW] = float(eff["rotor_skew"])
             par[P_SCURV] = float(eff["sampled_wind_curvature"])
+            par[P_INCF0], par[P_INCF1] = inclined_rotor_inplane(self.case.wind_speed)
         if op is not None and self.nonlinear_rotor:
             par[P_SBEND] = float(eff["blade_deflection"])
             par[P_DBEND] = bent.tip_deflection

@@ -16,7 +16,7 @@ import pytest
 import surrogates
 from surrogates.aero import blade_skew_table, skew_gains
 from surrogates.load_cases import load_case
-from surrogates.simulate import I_HUB, N_EX, P_SKF, P_SKM, P_SKT, Simulator
+from surrogates.simulate import I_HUB, N_EX, P_GIP, P_INCF0, P_INCF1, P_SKF, P_SKM, P_SKT, Simulator
 from surrogates.structure import N_DOF
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "reference" / "openfast" / "runs"
@@ -71,14 +71,26 @@ def test_an_inclined_rotor_carries_three_halves_of_one_blades_moment_times_the_i
     w_z = 12.0 * math.sin(theta - st.data.shaft_tilt_rad)  # the wind's component up the disc
     assert d[5] == pytest.approx(1.5 * g_m * w_z, rel=1e-9)  # yaw moment
     assert d[2] == pytest.approx(-1.5 * g_f * w_z, rel=1e-9)  # vertical in-plane force
-    assert d[4] == pytest.approx(0.0, abs=1e-6) and d[1] == pytest.approx(0.0, abs=1e-6)
-    # a yawed rotor: sideways in-plane wind -V sin(yaw) gives a tilt moment and a side force instead
+    assert d[4] == pytest.approx(0.0, abs=1e-6)
+    # the blades' cone and the skewed wake: each blade's in-plane force sees -eps (w . e_r), three blades at
+    # 120 deg sum cos^2 to 3/2: a side force 1.5 G eps w_z (blades straight here: the flap deflection is 0)
+    g_ip, eps0, eps1 = sim.par[[P_GIP, P_INCF0, P_INCF1]]
+    assert d[1] == pytest.approx(1.5 * g_ip * eps0 * w_z, rel=1e-9)
+    # bent 5 m downwind, eps grows by 5 eps1 (the bent blades' own share, with blade_deflection on)
+    x[10] = 5.0
+    d_bent = _hub_loads(on, case, x) - _hub_loads(off, case, x)
+    assert d_bent[1] == pytest.approx(1.5 * g_ip * (eps0 + 5.0 * eps1) * w_z, rel=1e-9)
+    x[10] = 0.0
+    # a yawed rotor: sideways in-plane wind -V sin(yaw) gives a tilt moment and a side force instead (and the
+    # cone's vertical force)
     x[4], x[5] = 0.0, math.radians(3.0)
     yaw = float(st.tower_top_rotation[2] @ x[:N_DOF])
     d = _hub_loads(on, case, x) - _hub_loads(off, case, x)
     w_y = -12.0 * math.sin(yaw)
     assert d[4] == pytest.approx(1.5 * g_m * w_y, rel=1e-9)
-    assert d[1] == pytest.approx(-1.5 * g_f * w_y, rel=1e-9)
+    w_z = 12.0 * math.sin(-st.data.shaft_tilt_rad)  # the shaft's own tilt still inclines the rotor
+    assert d[1] == pytest.approx(-1.5 * g_f * w_y + 1.5 * g_ip * eps0 * w_z, rel=1e-9)
+    assert d[2] == pytest.approx(-1.5 * g_f * w_z - 1.5 * g_ip * eps0 * w_y, rel=1e-9)
 
 
 def test_the_linear_model_holds_the_same_mean_yaw_as_the_nonlinear_rotor():
