@@ -981,10 +981,12 @@ def build_parser() -> argparse.ArgumentParser:
                "  fowt-env validate                                  # the packaged OC3 Hywind runs, 8 seeds\n"
                "  fowt-env validate --seeds 2 --duration 200 --runs c_op12 b_decay   # quick look\n"
                "  fowt-env validate ../shared/reference/openfast/runs --json fidelity.json --plot figs\n"
-               "  fowt-env validate --replay --seeds 1              # same waves and wind as OpenFAST: R² per channel")
+               "  fowt-env validate --replay --seeds 1              # same waves and wind as OpenFAST: R² per channel\n"
+               "  fowt-env validate heldout                          # runs nothing was calibrated on")
     vd.add_argument("reference", nargs="?", default=None,
                     help="folder of OpenFAST outputs (.outb/.out/.npz/.csv/.parquet) with <run>.case.json sidecars "
-                         "(default: the compact OC3 Hywind runs shipped with fowt-env)")
+                         "(default: the compact OC3 Hywind runs shipped with fowt-env; 'heldout': the shipped "
+                         "held-out runs at 10/12/14/18 m/s with seeds nothing was calibrated on)")
     vd.add_argument("--seeds", type=int, default=8, help="surrogate seeds per operating run (default 8)")
     vd.add_argument("--duration", type=float, default=None,
                     help="simulated seconds per operating run (default: the reference's, 600 s)")

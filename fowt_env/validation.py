@@ -933,6 +933,17 @@ def packaged_reference_dir() -> Path:
     return Path(str(resources.files("fowt_env") / "data" / PACKAGE_DATA))
 
 
+HELDOUT_DATA = "openfast_heldout"
+"""Package folder of the compact held-out OpenFAST runs (``reference="heldout"``): the shared OC3 deck run here with
+new TurbSim and wave seeds at 10, 12, 14 and 18 m/s (``tools/openfast_heldout_runs.py``), on which nothing in the
+surrogate was calibrated."""
+
+
+def packaged_heldout_dir() -> Path:
+    """Folder of the compact held-out OpenFAST runs shipped with fowt_env (:data:`HELDOUT_DATA`)."""
+    return Path(str(resources.files("fowt_env") / "data" / HELDOUT_DATA))
+
+
 def _kind(case: Mapping[str, Any]) -> str:
     return "decay" if case.get("initial") else "operating"
 
@@ -1007,7 +1018,8 @@ def load_reference(reference: str | os.PathLike[str] | None = None, runs: Sequen
     Parameters
     ----------
     reference : str or path-like, optional
-        None: the packaged compact data. A folder: searched recursively for ``<run>.case.json`` sidecars, each
+        None: the packaged compact data; ``"heldout"``: the packaged held-out runs (:data:`HELDOUT_DATA`). A
+        folder: searched recursively for ``<run>.case.json`` sidecars, each
         beside a record ``<run>.outb`` / ``.out`` / ``.npz`` / ``.csv`` / ``.parquet``; a folder holding a
         ``summary.json`` written by ``tools/compact_openfast_reference.py`` is read like the packaged data.
     runs : sequence of str, optional
@@ -1025,7 +1037,12 @@ def load_reference(reference: str | os.PathLike[str] | None = None, runs: Sequen
     """
     from .io import load_record
 
-    root = packaged_reference_dir() if reference is None else Path(reference)
+    if reference is None:
+        root = packaged_reference_dir()
+    elif str(reference) == "heldout" and not Path(reference).exists():
+        root = packaged_heldout_dir()
+    else:
+        root = Path(reference)
     if not root.is_dir():
         raise ValueError(f"reference must be a folder of OpenFAST runs with case.json sidecars, got {str(root)!r}")
     skipped: list[dict[str, str]] = []
@@ -1435,7 +1452,8 @@ def validate(
     Parameters
     ----------
     reference : str or path-like, optional
-        None (default): the packaged compact OC3 Hywind runs (statistics precomputed at 80 Hz). A folder:
+        None (default): the packaged compact OC3 Hywind runs (statistics precomputed at 80 Hz); ``"heldout"``:
+        the packaged held-out runs (:data:`HELDOUT_DATA`). A folder:
         OpenFAST outputs of any readable format, each with a ``<run>.case.json`` sidecar
         (see :func:`load_reference`), e.g. ``shared/reference/openfast/runs``.
     model : surrogates.FOWTModel, optional

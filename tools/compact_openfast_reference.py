@@ -28,6 +28,7 @@ change; ``fowt_env.validation`` recomputes the statistics from the records when 
 from __future__ import annotations
 
 import argparse
+import fnmatch
 import hashlib
 import json
 import shutil
@@ -128,11 +129,21 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--source", type=Path, default=DEFAULT_SOURCE, help="folder of OpenFAST run folders")
     ap.add_argument("--out", type=Path, default=DEFAULT_OUT, help="output folder")
     ap.add_argument("--inflow-only", action="store_true", help="write only the compact inflow files")
+    ap.add_argument("--no-inflow", action="store_true", help="write no compact inflow files (replays then use "
+                    "Wind1VelX)")
+    ap.add_argument("--runs", nargs="+", default=None, metavar="PATTERN",
+                    help="only the run folders matching these glob patterns (default all)")
+    ap.add_argument("--readme", default="shared/reference/openfast/README.md (OpenFAST v5.0.0, commit 2895884d, "
+                    "OC3 Hywind deck)", help="where the runs are described (written into summary.json)")
     args = ap.parse_args(argv)
     src: Path = args.source.resolve()
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
-    inflows = sorted(src.glob("*/*.inflow.npz"))
+
+    def wanted(name: str) -> bool:
+        return args.runs is None or any(fnmatch.fnmatch(name, p) for p in args.runs)
+
+    inflows = [] if args.no_inflow else [p for p in sorted(src.glob("*/*.inflow.npz")) if wanted(p.parent.name)]
     for path in inflows:
         case_path = path.parent / (path.name[: -len(".inflow.npz")] + ".case.json")
         if not case_path.is_file():
@@ -147,12 +158,14 @@ def main(argv: list[str] | None = None) -> int:
         "format": validation.SUMMARY_FORMAT, "version": 1,
         "created_by": "tools/compact_openfast_reference.py",
         "source_dir": str(src),
-        "source_readme": "shared/reference/openfast/README.md (OpenFAST v5.0.0, commit 2895884d, OC3 Hywind deck)",
+        "source_readme": args.readme,
         "method": validation._clean(validation.STATISTICS_METHOD),
         "runs": {}, "skipped": [],
     }
     for case_path in sorted(src.glob("*/*.case.json")):
         name = case_path.name[: -len(".case.json")]
+        if not wanted(case_path.parent.name):
+            continue
         outb = case_path.with_name(name + ".outb")
         case = json.loads(case_path.read_text(encoding="utf-8"))
         kind = "decay" if case.get("initial") else "operating"
