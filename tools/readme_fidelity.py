@@ -53,7 +53,8 @@ def heldout_block(report, seeds: int) -> str:
              f"{seeds} surrogate seeds).", "",
              "| run | graded checks passed | means, surrogate / OpenFAST: " + ", ".join(MEANS) + " | failing |",
              "|---|---|---|---|"]
-    for run in report.runs:
+    for info in report.runs:
+        run = info["name"]
         graded = [c for c in report.graded if c.run == run]
         if not graded:
             continue
