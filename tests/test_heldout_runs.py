@@ -28,6 +28,7 @@ def test_the_heldout_runs_are_packaged_with_their_provenance():
         assert len(info["source"]["sha256"]) == 64 and info["source"]["fs_hz"] == pytest.approx(80.0)
         case = json.loads((HELDOUT / f"{name}.case.json").read_text())
         assert case["turbulence_seed"] == case["wave_seed"] and "not in the shared set" in case["source"]
+        assert (HELDOUT / f"{name}.inflow.npz").is_file()  # the replay's wind field
     runs, skipped = validation.load_reference("heldout")
     assert sorted(r.name for r in runs) == sorted(RUNS) and not skipped
 

@@ -18,7 +18,8 @@ What
     ``case.json`` sidecar and the ``inflow.npz`` (the shared folder's ``tools/bts_inflow.py``, shifted by the
     grid's convection time half a grid width over the mean wind as the shared files are, and checked against
     ``Wind1VelX``), then the compact copy ``fowt_env/data/openfast_heldout/`` with
-    ``tools/compact_openfast_reference.py --no-inflow`` (records at 10 Hz, statistics at 80 Hz).
+    ``tools/compact_openfast_reference.py`` (records at 10 Hz, statistics at 80 Hz, the inflow fields at 5 Hz for
+    ``fowt-env validate heldout --replay``).
 
 Why
     The surrogate is checked on OpenFAST runs it has not seen (other seeds, other wind speeds); these are such
@@ -147,7 +148,7 @@ def main(argv: list[str] | None = None) -> int:
         for msg in pool.map(one, args.runs):
             print(msg, flush=True)
     subprocess.run([sys.executable, str(REPO / "tools" / "compact_openfast_reference.py"), "--source",
-                    str(work / "runs"), "--out", str(args.out), "--no-inflow", "--runs", *RUNS,
+                    str(work / "runs"), "--out", str(args.out), "--runs", *RUNS,
                     "--readme", "tools/openfast_heldout_runs.py (OpenFAST v5.0.0, commit 2895884d, the shared OC3 "
                     "Hywind deck, new seeds and wind speeds)"], check=True)
     return 0
