@@ -43,6 +43,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from .oc3 import RHO_AIR
+from .validation import check_number
 
 __all__ = ["ROTOR_TABLES", "RotorTable", "rotor_table", "OperatingPoint", "operating_point", "RATED",
            "blade_inplane_sensitivity", "inplane_ring_weights", "BladeSkewTable", "blade_skew_table", "skew_gains",
@@ -524,8 +525,7 @@ def inclined_rotor_inplane(wind_speed: float) -> tuple[float, float]:
     >>> bool(abs(e0) < 0.05 and 0.01 < e1 < 0.03)  # the bent blades carry most of it near rated
     True
     """
-    if not np.isfinite(wind_speed) or wind_speed <= 0:
-        raise ValueError(f"wind_speed must be a positive finite number (m/s), got {wind_speed!r}")
+    wind_speed = check_number("wind_speed", wind_speed, positive=True)
     v, e0, e1 = _inclined_rotor_data()
     return float(np.interp(wind_speed, v, e0)), float(np.interp(wind_speed, v, e1))
 

@@ -211,6 +211,16 @@ def deflected_blade(ad_blade: Path, coeffs: np.ndarray, tip_deflection: float, o
     return out
 
 
+def bent_blade_overrides(inp: dict, tip_deflection: float, out: Path) -> dict[str, str]:
+    """AeroDyn input overrides ``{"ADBlFile(i)": path}`` pointing all three blades at the deck's blade bent downwind
+    by ``tip_deflection`` m (:func:`deflected_blade`, written to ``out``); ``{}`` for 0 (straight blades)."""
+    if not tip_deflection:
+        return {}
+    ad_blade = (inp["ad"].parent / _value(inp["ad"].read_text(), "ADBlFile(1)").strip('"')).resolve()
+    bent = deflected_blade(ad_blade, flap_mode_shape(inp["ed"]), tip_deflection, out)
+    return {f"ADBlFile({i})": f'"{bent}"' for i in (1, 2, 3)}
+
+
 def _is_numbers(tokens: list[str]) -> bool:
     try:
         [float(t) for t in tokens]
@@ -393,11 +403,7 @@ def run_grid(args, inp: dict, tsr: np.ndarray, pitch: np.ndarray) -> tuple[list[
     work = Path(args.workdir) if args.workdir else Path(tempfile.mkdtemp(prefix="aerodyn_rotor_table_"))
     work.mkdir(parents=True, exist_ok=True)
     changed = overrides(args)
-    if args.flap_deflection:
-        ad_blade = (inp["ad"].parent / _value(inp["ad"].read_text(), "ADBlFile(1)").strip('"')).resolve()
-        bent = deflected_blade(ad_blade, flap_mode_shape(inp["ed"]), args.flap_deflection,
-                               work / f"blade_flap{args.flap_deflection:g}m.dat")
-        changed.update({f"ADBlFile({i})": f'"{bent}"' for i in (1, 2, 3)})
+    changed.update(bent_blade_overrides(inp, args.flap_deflection, work / f"blade_flap{args.flap_deflection:g}m.dat"))
     ad_text, _ = aerodyn_copy(inp["ad"], changed)
     key = settings_key(args, sha256(inp["ad"]), sha256(driver))
     rows = []

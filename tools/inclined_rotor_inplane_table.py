@@ -130,14 +130,16 @@ def main(argv: list[str] | None = None) -> int:
     ad_blade = (inp["ad"].parent / art._value(inp["ad"].read_text(), "ADBlFile(1)").strip('"')).resolve()
     work = Path(args.workdir)
     work.mkdir(parents=True, exist_ok=True)
+
+    def aerodyn_text(tip: float) -> tuple[str, dict]:
+        """The deck's AeroDyn input with blades bent ``tip`` m (0: straight) and this tool's outputs."""
+        over = art.bent_blade_overrides(inp, tip, work / f"blade_{tip:g}m.dat")
+        text, settings = art.aerodyn_copy(inp["ad"], over)
+        return text.replace('"RtAeroFxh, RtAeroMxh, RtTSR, RtVAvgxh"', '"' + ", ".join(OUTPUTS) + '"'), settings
+
     loads: dict[tuple[float, float], list[dict[str, float]]] = {}
     for tip in (0.0, args.tip):
-        over: dict[str, str] = {}
-        if tip:
-            bent = art.deflected_blade(ad_blade, art.flap_mode_shape(inp["ed"]), tip, work / f"blade_{tip:g}m.dat")
-            over = {f"ADBlFile({i})": f'"{bent}"' for i in (1, 2, 3)}
-        ad_text, settings = art.aerodyn_copy(inp["ad"], over)
-        ad_text = ad_text.replace('"RtAeroFxh, RtAeroMxh, RtTSR, RtVAvgxh"', '"' + ", ".join(OUTPUTS) + '"')
+        ad_text, settings = aerodyn_text(tip)
         for tilt in args.tilts:
             loads[(tip, tilt)] = driver_run(Path(args.driver), work / f"tip{tip:g}_tilt{tilt:g}", ad_text, inp,
                                             tilt, list(zip(v_drv, pitch, strict=True)), args.revs)
@@ -151,12 +153,7 @@ def main(argv: list[str] | None = None) -> int:
     v_chk = omega * radius / check["tip_speed_ratio"]
     side = {}
     for tip in (0.0, check["tip_deflection_m"]):
-        over = {}
-        if tip:
-            bent = art.deflected_blade(ad_blade, art.flap_mode_shape(inp["ed"]), tip, work / f"blade_{tip:g}m.dat")
-            over = {f"ADBlFile({i})": f'"{bent}"' for i in (1, 2, 3)}
-        ad_text, _ = art.aerodyn_copy(inp["ad"], over)
-        ad_text = ad_text.replace('"RtAeroFxh, RtAeroMxh, RtTSR, RtVAvgxh"', '"' + ", ".join(OUTPUTS) + '"')
+        ad_text, _ = aerodyn_text(tip)
         res = driver_run(Path(args.driver), work / f"check_tip{tip:g}", ad_text, inp, check["inclination_deg"],
                          [(v_chk, p) for p in check["pitch_deg"]], args.revs)
         side["bent" if tip else "straight"] = [round(r["RtAeroFyi"], 1) for r in res]

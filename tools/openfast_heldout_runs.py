@@ -107,6 +107,9 @@ def main(argv: list[str] | None = None) -> int:
     sys.path.insert(0, str(work / "tools"))
     import make_runs  # the shared run generator (its deck paths resolve inside the working copy)
 
+    sys.path.insert(0, str(REPO))
+    from fowt_env.io import load_record
+
     def one(name: str) -> str:
         v, hs, tp, seed, ed = RUNS[name]
         stem = f"NTM_B_{int(v):02d}mps_s{seed}_700s"
@@ -126,9 +129,6 @@ def main(argv: list[str] | None = None) -> int:
             data = {k: z[k] for k in z.files}
         raw.unlink()
         data["t"] = data["t"] - GRID_HALF_WIDTH / float(data["uhub"])  # InflowWind's convection of the grid
-        sys.path.insert(0, str(REPO))
-        from fowt_env.io import load_record
-
         rec = load_record(rd / f"{name}.outb", unknown_channels="keep")
         err = float(np.max(np.abs(np.interp(rec.t, data["t"], data["hub_uvw"][:, 0]) - rec["Wind1VelX"])))
         if err > 0.01:
