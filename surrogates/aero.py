@@ -46,7 +46,8 @@ from .oc3 import RHO_AIR
 from .validation import check_number
 
 __all__ = ["ROTOR_TABLES", "RotorTable", "rotor_table", "OperatingPoint", "operating_point", "RATED",
-           "blade_inplane_sensitivity", "inplane_ring_weights", "BladeSkewTable", "blade_skew_table", "skew_gains",
+           "blade_inplane_sensitivity", "blade_inplane_gain", "inplane_ring_weights", "BladeSkewTable",
+           "blade_skew_table", "skew_gains",
            "BladeDeflectionTable", "blade_deflection_table"]
 
 RATED = {
@@ -338,6 +339,32 @@ def blade_inplane_sensitivity(wind_speed: float) -> tuple[np.ndarray, np.ndarray
     j = int(np.clip(np.searchsorted(speeds, v) - 1, 0, speeds.size - 2))
     frac = (v - speeds[j]) / (speeds[j + 1] - speeds[j])
     return radius.copy(), (1.0 - frac) * per_node[j] + frac * per_node[j + 1]
+
+
+def blade_inplane_gain(wind_speed: float) -> float:
+    """One blade's in-plane force per m/s of uniform axial wind (N·s/m) at the operating point of `wind_speed`.
+
+    The sum over the span of :func:`blade_inplane_sensitivity`, with the wind speed taken to 0.01 m/s (as
+    :func:`inplane_ring_weights` does), so the linear model, the simulation and the replay use one number.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Mean wind speed (m/s), > 0.
+
+    Returns
+    -------
+    float
+        N per m/s.
+
+    Examples
+    --------
+    >>> round(blade_inplane_gain(12.0) / 1e3, 1)
+    9.2
+    """
+    if not np.isfinite(wind_speed) or wind_speed <= 0:
+        raise ValueError(f"wind_speed must be a positive finite number (m/s), got {wind_speed!r}")
+    return float(blade_inplane_sensitivity(round(float(wind_speed), 2))[1].sum())
 
 
 def inplane_ring_weights(ring_radii: np.ndarray, wind_speed: float) -> tuple[np.ndarray, float]:

@@ -42,7 +42,13 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
-from .aero import OperatingPoint, blade_inplane_sensitivity, inclined_rotor_inplane, operating_point, skew_gains
+from .aero import (
+    OperatingPoint,
+    blade_inplane_gain,
+    inclined_rotor_inplane,
+    operating_point,
+    skew_gains,
+)
 from .channels import ALL_CHANNELS, GAUGE_HEIGHTS, UNITS, tower_channels
 from .controller import DISCON
 from .drag import DragStrips, drag_strips, wave_velocity_rao, with_relative_velocity_std
@@ -530,7 +536,7 @@ class FOWTModel:
             # the coned blades and the skewed wake meet the in-plane wind as a gradient against it: each blade's
             # in-plane force sees -eps (w . e_r), a side force from w_z and a vertical one from w_y (eps at the
             # mean flap deflection; its change with the deflection loads the hub from the flap mode)
-            g_ip = float(blade_inplane_sensitivity(lc.wind_speed)[1].sum())
+            g_ip = blade_inplane_gain(lc.wind_speed)
             e0, e1 = inclined_rotor_inplane(lc.wind_speed)
             s_bend = eff["blade_deflection"]
             eps = e0 + s_bend * e1 * float(q_static[_FLAP])

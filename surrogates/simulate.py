@@ -27,6 +27,7 @@ import scipy.linalg as sla
 
 from .aero import (
     blade_deflection_table,
+    blade_inplane_gain,
     blade_inplane_sensitivity,
     inclined_rotor_inplane,
     inplane_ring_weights,
@@ -244,7 +245,7 @@ def sampled_shear_harmonics(wind_speed: float = HARMONICS_WIND_SPEED,
     v_ip = blade_effective_wind(polar[None], radii, az, N_BLADE_AZIMUTH, w_ip)[0].astype(float)
     disc = float(np.mean(v_t))
     r_t, r_ty = blade_load_radii(rt.radius)
-    g_ip = float(blade_inplane_sensitivity(round(wind_speed, 2))[1].sum())
+    g_ip = blade_inplane_gain(wind_speed)
     psi = np.linspace(0.0, 2.0 * np.pi, 360, endpoint=False)
     az_n = np.arange(N_BLADE_AZIMUTH) * 2.0 * np.pi / N_BLADE_AZIMUTH
     thrust = np.zeros_like(psi)

@@ -101,7 +101,7 @@ def driver_run(driver: Path, work: Path, ad_text: str, inp: dict, tilt: float, c
 
 
 def main(argv: list[str] | None = None) -> int:
-    from surrogates.aero import blade_inplane_sensitivity, operating_point, rotor_table
+    from surrogates.aero import blade_inplane_gain, operating_point, rotor_table
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--driver", required=True, help="aerodyn_driver binary (OpenFAST v5.0.0 build)")
@@ -124,7 +124,7 @@ def main(argv: list[str] | None = None) -> int:
     lam = np.array([op.rotor_speed * radius / v for op, v in zip(ops, winds, strict=True)])
     pitch = np.array([math.degrees(op.pitch) for op in ops])
     v_drv = omega * radius / lam
-    gain = np.array([float(blade_inplane_sensitivity(float(v))[1].sum()) for v in winds])  # N/(m/s) at V
+    gain = np.array([blade_inplane_gain(float(v)) for v in winds])  # N/(m/s) at V
     gain_drv = gain * v_drv / winds
 
     ad_blade = (inp["ad"].parent / art._value(inp["ad"].read_text(), "ADBlFile(1)").strip('"')).resolve()
