@@ -218,7 +218,8 @@ def _sidecar(path: Path, suffix: str) -> Path | None:
 
 
 def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: Any = None, model: Any = None,
-                  transient: float = 100.0, dt: float = 0.025, initial: bool = True, seed: int = 0,
+                  transient: float = 100.0, dt: float = 0.025, initial: bool | Mapping[str, float] = True,
+                  seed: int = 0,
                   measured_azimuth: bool = True, on_progress: Callable[[float], None] | None = None) -> Any:
     """Simulate the surrogate under a record's measured waves and wind.
 
@@ -238,8 +239,10 @@ def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: A
         Start-up discarded (s).
     dt : float
         Output sample time (s).
-    initial : bool
-        Start from the record's first sample (:func:`record_initial`) instead of the static equilibrium.
+    initial : bool or mapping
+        True: start from the record's first sample (:func:`record_initial`); False: from the static equilibrium;
+        a mapping: these initial conditions (OpenFAST names and units, as ``surrogates.simulate(initial=...)``),
+        e.g. a deck's ElastoDyn initial conditions for a record that starts at its run's t = 0.
     seed : int
         Seeds only the rotor's initial azimuth (when the record has no ``Azimuth``).
     measured_azimuth : bool
@@ -294,7 +297,10 @@ def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: A
             wind_in = MeasuredWind.from_record(record)
     if waves_in is None and wind_in is None:
         raise ValueError("the record has neither a wave elevation (Wave1Elev) nor a wind (Wind1VelX) to replay")
-    init = record_initial(record) if initial else None
+    if isinstance(initial, Mapping):
+        init: dict[str, float] | None = {str(k): float(v) for k, v in initial.items()}
+    else:
+        init = record_initial(record) if initial else None
     if init and lc.wind_speed <= 0:
         for name in ROTOR_INITIAL_CHANNELS:
             init.pop(name, None)

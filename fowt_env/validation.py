@@ -1121,10 +1121,11 @@ def reference_statistics(run: ReferenceRun, channels: Iterable[str]) -> dict[str
 def surrogate_case(case: Mapping[str, Any]) -> Any:
     """The surrogate's load case for a run's ``case.json`` (None for a free decay: parked, still water).
 
-    Uses ``surrogates.operating_case`` (rotor speed from the controller's steady state) when the surrogate
-    has it; otherwise a :class:`surrogates.LoadCase` with ``rotor_rpm = min(12.1, 7.55 V 30 / (pi 63))``
-    (optimal tip-speed ratio 7.55, rotor radius 63 m) and the IEC class B NTM turbulence intensity if the
-    case gives none.
+    Without wind (``wind_speed`` 0 or absent) the rotor is parked (``rotor_rpm = 0``, no aerodynamics: the
+    decks' ``CompAero = 0``) in the case's sea. Otherwise it uses ``surrogates.operating_case`` (rotor speed from
+    the controller's steady state) when the surrogate has it; otherwise a :class:`surrogates.LoadCase` with
+    ``rotor_rpm = min(12.1, 7.55 V 30 / (pi 63))`` (optimal tip-speed ratio 7.55, rotor radius 63 m) and the IEC
+    class B NTM turbulence intensity if the case gives none.
 
     Parameters
     ----------
@@ -1147,6 +1148,9 @@ def surrogate_case(case: Mapping[str, Any]) -> Any:
     wave_dir = float(case.get("wave_dir_deg") or 0.0)
     ti = case.get("turbulence_intensity")
     name = str(case.get("name", "custom"))
+    if v <= 0.0:  # still air: the parked rotor (blades at rest, no aerodynamics), in the case's sea
+        return surrogates.LoadCase(hs=hs, tp=tp, wave_dir_deg=wave_dir, wind_speed=0.0, rotor_rpm=0.0,
+                                   turbulence_intensity=0.0, gamma=gamma, name=name)
     if hasattr(surrogates, "operating_case"):
         return surrogates.operating_case(v, hs, tp, gamma=gamma, wave_dir_deg=wave_dir,
                                          turbulence_intensity=None if ti is None else float(ti), name=name)

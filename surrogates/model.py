@@ -749,16 +749,16 @@ class FOWTModel:
         pow_u[ir + 2] += 1.0
         rot_x, rot_u = thrust_x.copy(), thrust_u.copy()
         rot_u[ir + 3] += 1.0
-        if op is not None:  # ElastoDyn's RotThrust: + rotor weight and inertia along the tilted shaft
-            m_rot = st.data.rotor_mass
-            tilt = st.data.shaft_tilt_rad
-            rot_u[0] += -m_rot * GRAVITY * np.sin(tilt)  # tilt < 0: the weight pushes down the shaft
-            rot_x[:N_DOF] += m_rot * GRAVITY * np.cos(tilt) * st.tower_top_rotation[1]
-            # inertia along the shaft: the rotor's mass with the hub, the blades' flap mode with int m phi
-            inertia = m_rot * h_v
-            inertia[_FLAP] = st.data.n_blades * st.data.blade_flap.first_moment
-            rot_x -= inertia @ qdd_x
-            rot_u -= inertia @ qdd_u
+        # ElastoDyn's RotThrust: + rotor weight and inertia along the tilted shaft (a parked rotor's too)
+        m_rot = st.data.rotor_mass
+        tilt = st.data.shaft_tilt_rad
+        rot_u[0] += -m_rot * GRAVITY * np.sin(tilt)  # tilt < 0: the weight pushes down the shaft
+        rot_x[:N_DOF] += m_rot * GRAVITY * np.cos(tilt) * st.tower_top_rotation[1]
+        # inertia along the shaft: the rotor's mass with the hub, the blades' flap mode with int m phi
+        inertia = m_rot * h_v
+        inertia[_FLAP] = st.data.n_blades * st.data.blade_flap.first_moment
+        rot_x -= inertia @ qdd_x
+        rot_u -= inertia @ qdd_u
         rows_x["BldPitch1"], rows_u["BldPitch1"] = np.rad2deg(pitch_x), np.rad2deg(pitch_u)
         rows_x["GenTq"], rows_u["GenTq"] = gen_x / 1e3, gen_u / 1e3
         rows_x["GenPwr"], rows_u["GenPwr"] = pow_x / 1e3, pow_u / 1e3

@@ -1,0 +1,155 @@
+"""Make OpenFAST runs of the OC3 deck that start from the deck's initial state, for time-domain checks.
+
+What
+    Two 400 s runs of the shared OC3 Hywind deck with output from t = 0 (the shared operating runs drop their
+    first 100 s), in the steady-wind run's sea (JONSWAP Hs 2.5 m, Tp 10 s, SeaState's default peak shape, wave
+    seed 1201, ``WaveTMax`` 3600 s: the same elevation as ``d_steady12_Hs2p5_Tp10``):
+
+    ==============================  ================================================================
+    run                             conditions
+    ==============================  ================================================================
+    t_steady12_Hs2p5_Tp10_from0     steady 12 m/s wind (shear 0.2), operating, from the deck's
+                                    initial conditions (surge 20 m, pitch 4.5 deg, 12.1 rpm):
+                                    the shared steady-wind run with its start-up kept
+    t_parked_Hs2p5_Tp10             still air, no aerodynamics, rotor parked (the free decays'
+                                    settings), platform at rest at the origin
+    ==============================  ================================================================
+
+    For each it writes the ``case.json`` sidecar, then the compact copy ``fowt_env/data/openfast_time_domain/``:
+    records at 10 Hz (anti-alias filtered, float32 precision; :func:`compact_openfast_reference.compact`), the
+    case files with the ElastoDyn initial conditions (``start``), and ``summary.json`` with the sha256 of every
+    source file.
+
+Why
+    Starting where OpenFAST starts and driven by its own wave elevation, the surrogate must follow OpenFAST's time
+    series, not only its statistics: ``fowt-env validate time-domain`` (:func:`fowt_env.validation.time_domain`)
+    replays both runs and reports R^2 per channel. A replay that starts inside a record (the shared runs begin
+    100 s in) rings at the platform's 30 s and 120 s periods while it forgets the sea before its start; these
+    runs have no such start.
+
+Usage (maintainer tool, not run by the tests; OpenFAST ~11 and ~8 min on one core, the two in parallel)::
+
+    python tools/openfast_time_domain_runs.py --openfast-build /tmp/of/build --work /tmp/ofx [--shared ../shared]
+
+``--openfast-build`` is the cmake build tree of the reference build (``<shared>/reference/openfast/build.sh``;
+the DISCON controller is compiled into the working copy of the decks here). A run whose ``.outb`` exists is not
+run again.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+DEFAULT_SHARED = REPO.parent / "shared"
+DEFAULT_OUT = REPO / "fowt_env" / "data" / "openfast_time_domain"
+
+SEA = dict(WaveMod=2, WaveHs=2.5, WaveTp=10, WaveTMax=3600, WaveSeed1=1201)
+RUNS = {
+    "t_steady12_Hs2p5_Tp10_from0": dict(TMax=400, TStart=0, wind=("steady", 12.0), sea=SEA,
+                                        ed=dict(RotSpeed=12.1, BlPitch=0.0, PtfmSurge=20, PtfmPitch=4.5)),
+    "t_parked_Hs2p5_Tp10": dict(TMax=400, TStart=0, wind=None, sea=SEA, ed=dict(GenDOF="False", RotSpeed=0)),
+}
+CASES = {
+    "t_steady12_Hs2p5_Tp10_from0": {
+        "wind_speed": 12.0, "turbulence_intensity": 0.0, "shear_exponent": 0.2,
+        "turbulence_model": "steady wind (InflowWind WindType 1), power-law shear exponent 0.2",
+        "note": "the shared d_steady12_Hs2p5_Tp10 run with its output from t = 0 (the deck's initial conditions)"},
+    "t_parked_Hs2p5_Tp10": {
+        "wind_speed": 0.0, "rotor": "parked (GenDOF off, RotSpeed 0), no aerodynamics (CompAero 0, CompInflow 0)",
+        "note": "the free decays' settings in the d_steady12_Hs2p5_Tp10 sea, platform at rest at the origin"},
+}
+CHANNELS = ("PtfmSurge", "PtfmSway", "PtfmHeave", "PtfmRoll", "PtfmPitch", "PtfmYaw", "RotSpeed", "BldPitch1",
+            "GenPwr", "GenTq", "RotThrust", "TwrBsMyt", "TwrBsMxt", "YawBrTAxp", "YawBrTAyp", "TTDspFA", "TTDspSS",
+            "Wave1Elev", "Wind1VelX", "TwHt1MLxt", "TwHt1MLyt", "TwHt9ALxt", "TwHt9ALyt", "TwHt9MLxt", "TwHt9MLyt")
+"""Channels of the compact records (those the run has, constant ones dropped)."""
+FS_OUT = 10.0
+
+
+def sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with path.open("rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--openfast-build", required=True, type=Path, help="cmake build tree (openfast)")
+    ap.add_argument("--work", required=True, type=Path, help="working copy of the shared decks and the runs")
+    ap.add_argument("--shared", default=DEFAULT_SHARED, type=Path)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--out", default=DEFAULT_OUT, type=Path)
+    args = ap.parse_args(argv)
+
+    ref = args.shared / "reference" / "openfast"
+    work: Path = args.work
+    for sub in ("decks", "tools"):
+        if not (work / sub).is_dir():
+            shutil.copytree(ref / sub, work / sub)
+    (work / "runs").mkdir(exist_ok=True)
+    servo = work / "decks" / "5MW_Baseline" / "ServoData"
+    if not (servo / "DISCON_OC3Hywind.dll").is_file():
+        subprocess.run(["gfortran", "-shared", "-fPIC", "-O2", "-cpp", "-ffree-line-length-none",
+                        "DISCON_OC3Hywind.f90", "-o", "DISCON_OC3Hywind.dll"], cwd=servo, check=True)
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1",
+           "OPENFAST": str(args.openfast_build / "glue-codes" / "openfast" / "openfast")}
+    sys.path.insert(0, str(work / "tools"))
+    import make_runs  # the shared run generator (its deck paths resolve inside the working copy)
+
+    sys.path.insert(0, str(REPO))
+    sys.path.insert(0, str(REPO / "tools"))
+    from compact_openfast_reference import compact
+
+    from fowt_env import validation
+    from fowt_env.io import load_record
+
+    def one(name: str) -> str:
+        make_runs.build(name, RUNS[name])
+        rd = work / "runs" / name
+        if not (rd / f"{name}.outb").is_file():
+            subprocess.run(["bash", str(work / "tools" / "run_case.sh"), name], env=env, check=True)
+        case = {"name": name, "wave_dir_deg": 0.0, "hs": 2.5, "tp": 10.0, "gamma": 1.0, "wave_seed": 1201,
+                **CASES[name], "transient_s": 0.0, "duration_s": 400.0,
+                "gamma_note": "SeaState WavePkShp = DEFAULT (IEC 61400-3 rule from Tp/sqrt(Hs))",
+                "source": "tools/openfast_time_domain_runs.py: the shared OC3 deck (OpenFAST v5.0.0, 2895884d), "
+                          "output from t = 0"}
+        (rd / f"{name}.case.json").write_text(json.dumps(case, indent=1) + "\n")
+        return name
+
+    with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        names = list(pool.map(one, RUNS))
+
+    out: Path = args.out
+    out.mkdir(parents=True, exist_ok=True)
+    summary: dict = {"created_by": "tools/openfast_time_domain_runs.py", "fs_hz": FS_OUT, "runs": {}}
+    for name in names:
+        rd = work / "runs" / name
+        outb = rd / f"{name}.outb"
+        rec = load_record(outb, unknown_channels="keep")
+        chans = [c for c in CHANNELS if c in rec and float(rec[c].std()) > 0.0]
+        small = compact(rec, chans, FS_OUT, name, f"{name}/{outb.name}")
+        small.save(out / f"{name}.npz")
+        case = json.loads((rd / f"{name}.case.json").read_text())
+        case["start"] = validation.elastodyn_initial_conditions(rd / f"{name}_ElastoDyn.dat")
+        (out / f"{name}.case.json").write_text(json.dumps(case, indent=1) + "\n")
+        summary["runs"][name] = {
+            "source": {"path": str(outb), "bytes": outb.stat().st_size, "sha256": sha256(outb), "fs_hz": rec.fs},
+            "inputs_sha256": {p.name: sha256(p) for p in sorted(rd.glob("*.dat")) + sorted(rd.glob("*.fst"))},
+            "compact": {"file": f"{name}.npz", "fs_hz": FS_OUT, "channels": chans}}
+        print(f"{name}: {len(chans)} channels, {(out / f'{name}.npz').stat().st_size / 1e3:.0f} kB")
+    (out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
