@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import signal
 
 __all__ = [
+    "INITIAL_FIT_S",
     "REPLAY_BANDS",
     "REPLAY_CHANNELS",
     "ReplayScore",
@@ -50,6 +51,7 @@ __all__ = [
     "multiple_coherence",
     "record_case",
     "record_initial",
+    "replay_initial_state",
     "replay_record",
     "replay_scores",
     "scores_table",
@@ -217,46 +219,27 @@ def _sidecar(path: Path, suffix: str) -> Path | None:
     return None
 
 
-def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: Any = None, model: Any = None,
-                  transient: float = 100.0, dt: float = 0.025, initial: bool | Mapping[str, float] = True,
-                  seed: int = 0,
-                  measured_azimuth: bool = True, on_progress: Callable[[float], None] | None = None) -> Any:
-    """Simulate the surrogate under a record's measured waves and wind.
+INITIAL_FIT_S = 100.0
+"""Span (s) from a record's first sample over which ``initial="fit"`` fits the platform's initial state."""
 
-    Parameters
-    ----------
-    record : surrogates.Record or path
-        A record with ``Wave1Elev`` (m) and/or ``Wind1VelX`` (m/s); a path is read with
-        :func:`fowt_env.io.load_record`, and a ``<run>.case.json`` and ``<run>.inflow.npz`` beside it are used.
-    case : mapping, optional
-        The run's conditions (``case.json`` keys); default the sidecar, else estimated (:func:`record_case`).
-    wind : surrogates.replay.MeasuredWind or path, optional
-        A richer wind than the record's ``Wind1VelX``: a ``MeasuredWind``, an ``*.inflow.npz`` (polar field) or a
-        TurbSim ``.bts`` (full field). Default: the inflow sidecar if there is one, else ``Wind1VelX``.
-    model : surrogates.FOWTModel, optional
-        Default: the model with OpenFAST's gauge heights, no sensor noise.
-    transient : float
-        Start-up discarded (s).
-    dt : float
-        Output sample time (s).
-    initial : bool or mapping
-        True: start from the record's first sample (:func:`record_initial`); False: from the static equilibrium;
-        a mapping: these initial conditions (OpenFAST names and units, as ``surrogates.simulate(initial=...)``),
-        e.g. a deck's ElastoDyn initial conditions for a record that starts at its run's t = 0.
-    seed : int
-        Seeds only the rotor's initial azimuth (when the record has no ``Azimuth``).
-    measured_azimuth : bool
-        Replay the record's ``Azimuth`` channel, if it has one, as the blades' position in the wind field and
-        the phase of the 3P/6P loads (``surrogates.simulate(azimuth=...)``); False: the simulated rotor's own.
-    on_progress : callable, optional
-        Progress hook of :func:`surrogates.simulate` (simulated seconds just integrated; about the record's
-        length in all).
+_FIT_STEPS = {"PtfmSurge": (0.2, 0.01), "PtfmSway": (0.05, 0.005), "PtfmHeave": (0.02, 0.005),
+              "PtfmRoll": (0.02, 0.005), "PtfmPitch": (0.05, 0.01), "PtfmYaw": (0.02, 0.005)}
+"""Finite-difference steps of each platform DOF's position (m, deg) and rate (m/s, deg/s) in the fit."""
 
-    Returns
-    -------
-    surrogates.Record
-        Noise-free; time stamps on the record's own axis, from ``record.t[0] + transient``.
-    """
+
+@dataclass(frozen=True)
+class _ReplayInputs:
+    record: Any
+    case: Any
+    model: Any
+    waves: Any
+    wind: Any
+    azimuth: Any
+
+
+def _replay_inputs(record: Any, case: Mapping[str, Any] | None, wind: Any, model: Any,
+                   measured_azimuth: bool) -> _ReplayInputs:
+    """The record, load case, model and measured inputs of a replay (see :func:`replay_record`)."""
     import surrogates
     from surrogates.replay import MeasuredWaves, MeasuredWind, record_wind_plane
 
@@ -297,18 +280,153 @@ def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: A
             wind_in = MeasuredWind.from_record(record)
     if waves_in is None and wind_in is None:
         raise ValueError("the record has neither a wave elevation (Wave1Elev) nor a wind (Wind1VelX) to replay")
-    if isinstance(initial, Mapping):
-        init: dict[str, float] | None = {str(k): float(v) for k, v in initial.items()}
-    else:
-        init = record_initial(record) if initial else None
-    if init and lc.wind_speed <= 0:
-        for name in ROTOR_INITIAL_CHANNELS:
-            init.pop(name, None)
     # the rotor's measured azimuth places the blades in the field (a rotor speed 0.1 % off drifts 3P by ~90° in
     # ten minutes); parked, the harmonics are off anyway
     az = record if measured_azimuth and "Azimuth" in record.channels and lc.wind_speed > 0 else None
-    return surrogates.simulate(model, lc, dt=dt, seed=seed, transient=transient, noise=False, initial=init,
-                               waves=waves_in, wind=wind_in, azimuth=az, on_progress=on_progress)
+    return _ReplayInputs(record, lc, model, waves_in, wind_in, az)
+
+
+def _run(inp: _ReplayInputs, init: dict[str, float] | None, *, dt: float, seed: int, transient: float,
+         duration: float | None = None, on_progress: Callable[[float], None] | None = None) -> Any:
+    import surrogates
+
+    if init and inp.case.wind_speed <= 0:
+        init = {k: v for k, v in init.items() if k not in ROTOR_INITIAL_CHANNELS}
+    return surrogates.simulate(inp.model, inp.case, duration, dt=dt, seed=seed, transient=transient, noise=False,
+                               initial=init or None, waves=inp.waves, wind=inp.wind, azimuth=inp.azimuth,
+                               on_progress=on_progress)
+
+
+def _fit_initial(inp: _ReplayInputs, base: dict[str, float], span: float, seed: int) -> dict[str, float]:
+    """Gauss-Newton on the platform's initial positions and rates: the replay's platform series against the
+    record's over ``span`` seconds, each channel scaled by its std there (two iterations, a step kept only if it
+    lowers the misfit)."""
+    rec = inp.record
+    t = np.asarray(rec.t, float)
+    span = float(min(span, t[-1] - t[0]))
+    channels = [c for c in _FIT_STEPS if c in rec.channels]
+    if not channels or span < 10.0:
+        return base
+    sel = np.flatnonzero(t <= t[0] + span)[:: max(1, int(round(0.5 / float(rec.dt))))]  # ~2 Hz
+    ref = np.column_stack([np.asarray(rec[c], float)[sel] for c in channels])
+    scale = np.maximum(ref.std(axis=0), np.array([_FIT_STEPS[c][0] for c in channels]))
+
+    def residual(init: dict[str, float]) -> NDArray[np.float64]:
+        sim = _run(inp, init, dt=0.05, seed=seed, transient=0.0, duration=span)
+        st = np.asarray(sim.t, float)
+        mod = np.column_stack([np.interp(t[sel], st, np.asarray(sim[c], float)) for c in channels])
+        return ((mod - ref) / scale).ravel()
+
+    params = [(c, step[0]) for c, step in ((c, _FIT_STEPS[c]) for c in channels)]
+    params += [(_RATE_OF[c], _FIT_STEPS[c][1]) for c in channels]
+    best = dict(base)
+    r_best = residual(best)
+    for _ in range(2):
+        jac = np.empty((r_best.size, len(params)))
+        for j, (name, step) in enumerate(params):
+            trial = dict(best)
+            trial[name] = trial.get(name, 0.0) + step
+            jac[:, j] = (residual(trial) - r_best) / step
+        col = np.maximum(np.linalg.norm(jac, axis=0), 1e-12)
+        delta = np.linalg.lstsq(jac / col, -r_best, rcond=1e-6)[0] / col
+        trial = dict(best)
+        for (name, _), d in zip(params, delta, strict=True):
+            trial[name] = trial.get(name, 0.0) + float(d)
+        r_trial = residual(trial)
+        if float(r_trial @ r_trial) >= float(r_best @ r_best):
+            break
+        best, r_best = trial, r_trial
+    return best
+
+
+def replay_initial_state(record: Any, *, case: Mapping[str, Any] | None = None, wind: Any = None, model: Any = None,
+                         span: float = INITIAL_FIT_S, seed: int = 0, measured_azimuth: bool = True
+                         ) -> dict[str, float]:
+    """The platform's initial state that makes a replay follow a record from its first sample.
+
+    A record that starts inside a run (a field measurement, OpenFAST's output after its start-up) gives the
+    platform's positions and, from their slopes, its rates at the first sample (:func:`record_initial`), but not
+    the sea's history before it: the replay's wave loads and radiation memory start cold, and the slow modes (the
+    OC3 spar's 120 s surge and 30 s heave and pitch, lightly damped) ring for minutes with what that start puts in
+    them (OpenFAST's steady-wind run replayed from its first sample: 1.5x OpenFAST's surge below 0.05 Hz 100-300 s
+    later). This estimates the initial positions and rates of the platform DOFs the record has by least squares:
+    the replay's platform series against the record's over the first `span` seconds (a smoother of the initial
+    state, Gauss-Newton with finite differences, 2 x 12 short replays). Everything after `span` is untouched by the
+    fit, so a replay that discards its first `span` seconds is scored out of sample.
+
+    Parameters
+    ----------
+    record, case, wind, model, seed, measured_azimuth
+        As :func:`replay_record`.
+    span : float
+        Fitted span (s), >= 10 (shorter records: their length).
+
+    Returns
+    -------
+    dict
+        Initial conditions (OpenFAST names and units) for ``replay_record(initial=...)``: :func:`record_initial`
+        with the platform's positions and rates refined.
+    """
+    if not (np.isfinite(span) and span > 0):
+        raise ValueError(f"span must be a positive number of seconds, got {span!r}")
+    inp = _replay_inputs(record, case, wind, model, measured_azimuth)
+    return _fit_initial(inp, record_initial(inp.record), span, seed)
+
+
+def replay_record(record: Any, *, case: Mapping[str, Any] | None = None, wind: Any = None, model: Any = None,
+                  transient: float = 100.0, dt: float = 0.025, initial: bool | str | Mapping[str, float] = True,
+                  seed: int = 0,
+                  measured_azimuth: bool = True, on_progress: Callable[[float], None] | None = None) -> Any:
+    """Simulate the surrogate under a record's measured waves and wind.
+
+    Parameters
+    ----------
+    record : surrogates.Record or path
+        A record with ``Wave1Elev`` (m) and/or ``Wind1VelX`` (m/s); a path is read with
+        :func:`fowt_env.io.load_record`, and a ``<run>.case.json`` and ``<run>.inflow.npz`` beside it are used.
+    case : mapping, optional
+        The run's conditions (``case.json`` keys); default the sidecar, else estimated (:func:`record_case`).
+    wind : surrogates.replay.MeasuredWind or path, optional
+        A richer wind than the record's ``Wind1VelX``: a ``MeasuredWind``, an ``*.inflow.npz`` (polar field) or a
+        TurbSim ``.bts`` (full field). Default: the inflow sidecar if there is one, else ``Wind1VelX``.
+    model : surrogates.FOWTModel, optional
+        Default: the model with OpenFAST's gauge heights, no sensor noise.
+    transient : float
+        Start-up discarded (s).
+    dt : float
+        Output sample time (s).
+    initial : bool, "fit" or mapping
+        True: start from the record's first sample (:func:`record_initial`); ``"fit"``: from the platform state
+        fitted over the record's first ``min(transient, INITIAL_FIT_S)`` seconds (:func:`replay_initial_state`;
+        with ``transient`` >= that span the returned record is out of sample); False: from the static
+        equilibrium; a mapping: these initial conditions (OpenFAST names and units, as
+        ``surrogates.simulate(initial=...)``), e.g. a deck's ElastoDyn initial conditions for a record that starts
+        at its run's t = 0, or :func:`replay_initial_state`'s.
+    seed : int
+        Seeds only the rotor's initial azimuth (when the record has no ``Azimuth``).
+    measured_azimuth : bool
+        Replay the record's ``Azimuth`` channel, if it has one, as the blades' position in the wind field and
+        the phase of the 3P/6P loads (``surrogates.simulate(azimuth=...)``); False: the simulated rotor's own.
+    on_progress : callable, optional
+        Progress hook of :func:`surrogates.simulate` (simulated seconds just integrated; about the record's
+        length in all).
+
+    Returns
+    -------
+    surrogates.Record
+        Noise-free; time stamps on the record's own axis, from ``record.t[0] + transient``.
+    """
+    inp = _replay_inputs(record, case, wind, model, measured_azimuth)
+    if isinstance(initial, Mapping):
+        init: dict[str, float] | None = {str(k): float(v) for k, v in initial.items()}
+    elif isinstance(initial, str):
+        if initial != "fit":
+            raise ValueError(f"initial must be True, False, 'fit' or a mapping, got {initial!r}")
+        span = min(float(transient), INITIAL_FIT_S) if transient > 0 else INITIAL_FIT_S
+        init = _fit_initial(inp, record_initial(inp.record), span, seed)
+    else:
+        init = record_initial(inp.record) if initial else None
+    return _run(inp, init, dt=dt, seed=seed, transient=transient, on_progress=on_progress)
 
 
 def inflow_rotor_wind(path: str | os.PathLike[str]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

@@ -1375,7 +1375,8 @@ def _compare_operating(run: ReferenceRun, sims: list[Any], report: ValidationRep
 
 REPLAY_TRANSIENT_S = 100.0
 """Start-up (s) of a replay discarded by ``validate(replay=True)``: the replay starts from the record's first
-sample (positions, rotor speed), not from its velocities; 100 s are about ten pitch and heave periods."""
+sample with the platform's positions and rates fitted over these 100 s (:func:`fowt_env.replay.replay_initial_state`:
+the sea before the record is unknown, so its wave loads start cold), which are then not scored."""
 
 
 def replay_reference_window(run: ReferenceRun, replayed: Any) -> ReferenceRun:
@@ -1416,14 +1417,17 @@ def _replay_operating(run: ReferenceRun, model: Any, seeds: Sequence[int], dt: f
     """Replays of one operating run (one per seed: the rotor's initial azimuth), scored into ``report.replay``."""
     from surrogates.replay import MeasuredWind
 
-    from .replay import inflow_rotor_wind, replay_record, replay_scores
+    from .replay import inflow_rotor_wind, replay_initial_state, replay_record, replay_scores
 
     inflow = Path(run.source).with_name(f"{run.name}.inflow.npz") if run.source else None
     has_inflow = inflow is not None and inflow.is_file()
     wind = MeasuredWind.from_inflow(inflow) if has_inflow else None  # read once for every seed
     case = _with_measured_inputs(run, realised_ti=True)
+    # the platform's state at the record's first sample, fitted over the discarded start-up (out of sample after)
+    start = replay_initial_state(run.record, case=case, wind=wind, model=model, span=REPLAY_TRANSIENT_S,
+                                 seed=int(seeds[0]))
     sims = [replay_record(run.record, case=case, wind=wind, model=model, transient=REPLAY_TRANSIENT_S, dt=dt,
-                          seed=int(s)) for s in seeds]
+                          seed=int(s), initial=start) for s in seeds]
     rotor_wind = None
     if has_inflow:
         rotor_wind = inflow_rotor_wind(inflow)
