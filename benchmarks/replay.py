@@ -3,7 +3,8 @@
 For every operating run: the surrogate is driven by the run's own ``Wave1Elev`` and its wind (the polar rotor
 field of ``<run>.inflow.npz`` by default; ``--level rotor_effective`` its disc-mean wind, ``--level hub`` the
 ``Wind1VelX`` channel through the rotor-averaging filter), starts from the run's first sample (platform
-position, tower-top deflection, rotor speed and azimuth) and its first ``--transient`` seconds are discarded.
+position and rates fitted over the discarded start-up, ``replay_record(initial="fit")``; tower-top deflection,
+rotor speed and azimuth) and its first ``--transient`` seconds are discarded.
 Per channel and band it prints R² of the surrogate against OpenFAST and, beside it, the linear bound: the
 multiple coherence of the OpenFAST channel with the two inputs (wave elevation, rotor-averaged wind), computed
 from the OpenFAST record itself (``fowt_env.replay.coherence_bound``); ✗ marks R² < 0.85 x bound.
@@ -43,7 +44,7 @@ def replay_run(folder: Path, level: str, transient: float, dt: float) -> dict:
     inflow = folder / f"{name}.inflow.npz"
     wind = MeasuredWind.from_inflow(inflow, level=level) if inflow.is_file() else None
     t0 = time.perf_counter()
-    rp = replay_record(rec, case=case, wind=wind, transient=transient, dt=dt)
+    rp = replay_record(rec, case=case, wind=wind, transient=transient, dt=dt, initial="fit")
     wall = time.perf_counter() - t0
     rotor_wind = inflow_rotor_wind(inflow) if inflow.is_file() else None
     scores = replay_scores(rec, rp, rotor_wind, channels=SCORED + EXTRA)
