@@ -160,7 +160,8 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     with simulation_bar(measured.duration, "replay") as (bar, hook):  # the record's span: transient + output
         t0 = time.perf_counter()
         rec = replay_record(src, wind=args.wind_file, model=model, transient=args.transient, dt=args.dt,
-                            seed=args.seed, on_progress=hook)
+                            seed=args.seed, on_progress=hook,
+                            initial="fit" if args.start == "fit" and args.transient >= 10.0 else True)
         wall = time.perf_counter() - t0
         bar.update(bar.total - bar.n)  # the last samples' rounding
         bar.set_postfix_str(f"writing {Path(args.out).name}")
@@ -810,6 +811,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "reference *.inflow.npz (default: <run>.inflow.npz beside the record, if any)")
     s.add_argument("--transient", type=float, default=100.0,
                    help="with --replay: start-up discarded, s (default 100)")
+    s.add_argument("--start", choices=["fit", "first-sample"], default="fit",
+                   help="with --replay: the platform's initial positions and rates fitted to the record over the "
+                        "discarded start-up (default; the sea before the record is unknown, so its wave loads start "
+                        "cold), or taken from the record's first sample and its slopes")
     s.set_defaults(func=_cmd_simulate)
 
     e = sub.add_parser("episode", help="run an environment episode under sensor faults and save the records")
