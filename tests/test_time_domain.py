@@ -106,3 +106,16 @@ def test_the_cli_prints_and_writes_the_time_domain_scores(tmp_path, capsys):
     rows = json.loads(out.read_text())
     assert {r["channel"] for r in rows} >= {"PtfmSurge", "PtfmPitch"} and all(r["run"] == PARKED for r in rows)
     assert (tmp_path / "figs" / f"{PARKED}.png").is_file()
+
+
+def test_a_folder_of_runs_that_start_at_zero_is_scored_from_the_cli(tmp_path, capsys):
+    """``fowt-env validate DIR --time-domain``: a user's own runs (here a copy of the parked one)."""
+    import shutil
+
+    for suffix in (".npz", ".case.json"):
+        shutil.copyfile(DATA / f"{PARKED}{suffix}", tmp_path / f"{PARKED}{suffix}")
+    assert cli_main(["validate", str(tmp_path), "--time-domain"]) == 0
+    out = capsys.readouterr().out
+    assert PARKED in out and "TwrBsMyt" in out
+    scores = td.time_domain(tmp_path, channels=["TwrBsMyt"], skip=50.0)
+    assert len(scores) == 1 and scores[0].r2 >= 0.9
