@@ -47,7 +47,7 @@ from .validation import check_number
 
 __all__ = ["ROTOR_TABLES", "RotorTable", "rotor_table", "OperatingPoint", "operating_point", "RATED",
            "blade_inplane_sensitivity", "blade_inplane_gain", "inplane_ring_weights", "BladeSkewTable",
-           "blade_skew_table", "skew_gains",
+           "blade_skew_table", "skew_gains", "inclined_rotor_moment",
            "BladeDeflectionTable", "blade_deflection_table"]
 
 RATED = {
@@ -509,11 +509,58 @@ def skew_gains(wind_speed: float, inclination_rad: float) -> tuple[float, float,
 
 
 @lru_cache(maxsize=1)
-def _inclined_rotor_data() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _inclined_rotor_json() -> dict:
     import json
 
-    data = json.loads(resources.files("surrogates").joinpath("data/inclined_rotor_inplane.json").read_text())
+    return json.loads(resources.files("surrogates").joinpath("data/inclined_rotor_inplane.json").read_text())
+
+
+@lru_cache(maxsize=1)
+def _inclined_rotor_data() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    data = _inclined_rotor_json()
     return tuple(np.asarray(data[k], dtype=float) for k in ("wind_speed", "eps_straight", "eps_per_m"))
+
+
+def inclined_rotor_moment(wind_speed: float) -> tuple[float, float]:
+    """One blade's share of the inclined rotor's moment per m/s of in-plane wind, from AeroDyn (N m per m/s).
+
+    The rotor inclined under the wind meets its component ``W = V sin(inclination)`` up the disc: the blade going up
+    on one side and the one going down on the other see different airspeeds, and AeroDyn's skewed wake and the
+    blades' cone shift the induction across the disc. The moment about the rotor plane's vertical axis (a yaw
+    moment; a lateral ``W``, under a yaw misalignment, gives the tilt moment) changes by ``1.5 k W`` with
+    ``k = k_straight + k_per_m d`` for blades bent ``d`` m at the tip: the driver's change between the shaft inclined
+    5 and 10 deg at the operating point (``tools/inclined_rotor_inplane_table.py``, hub axes, in the table's
+    ``yaw_moment_change_Nm``), per ``1.5 dW``. The quasi-steady blade-element skew table
+    (:func:`skew_gains`) gives 1.4-1.8x this below rated, where the skewed wake's induction carries most of the
+    answer, and the same at 16-18 m/s; OpenFAST's held-platform runs follow AeroDyn (``YawBrMzp`` -233 kN m at 5 deg
+    in uniform 12 m/s wind with rigid blades: +130 kN m of the rotor's own less the 5 deg shaft's torque
+    projection).
+
+    Parameters
+    ----------
+    wind_speed : float
+        Mean wind speed (m/s), > 0; linear between the tabulated 4-25 m/s, held outside.
+
+    Returns
+    -------
+    (float, float)
+        ``k_straight`` (N m per m/s) and ``k_per_m`` (N m per m/s per m of tip deflection).
+
+    Examples
+    --------
+    >>> k0, k1 = inclined_rotor_moment(12.0)
+    >>> round(1.5 * k0 / 1e3), round(1.5 * (k0 + 5.0 * k1) / 1e3)  # kN m per m/s: straight, bent 5 m
+    (87, 62)
+    """
+    wind_speed = check_number("wind_speed", wind_speed, positive=True)
+    data = _inclined_rotor_json()
+    v = np.asarray(data["wind_speed"], dtype=float)
+    t0, t1 = (np.deg2rad(float(a)) for a in data["inclinations_deg"])
+    dw = 1.5 * v * (np.sin(t1) - np.sin(t0))
+    straight = np.asarray(data["yaw_moment_change_Nm"]["straight"], dtype=float) / dw
+    bent = np.asarray(data["yaw_moment_change_Nm"]["bent"], dtype=float) / dw
+    per_m = (bent - straight) / float(data["tip_deflection_m"])
+    return float(np.interp(wind_speed, v, straight)), float(np.interp(wind_speed, v, per_m))
 
 
 def inclined_rotor_inplane(wind_speed: float) -> tuple[float, float]:

@@ -46,6 +46,7 @@ from .aero import (
     OperatingPoint,
     blade_inplane_gain,
     inclined_rotor_inplane,
+    inclined_rotor_moment,
     operating_point,
     skew_gains,
 )
@@ -528,7 +529,10 @@ class FOWTModel:
         if linear_rotor and s_skew:
             theta0 = float(r_tt[1] @ q_static)
             inc0 = theta0 - st.data.shaft_tilt_rad
-            g_t, g_m, g_f = skew_gains(lc.wind_speed, inc0)
+            g_t, _, g_f = skew_gains(lc.wind_speed, inc0)
+            # the moment from AeroDyn (skewed wake, cone), at the mean flap deflection
+            m0, m1 = inclined_rotor_moment(lc.wind_speed)
+            g_m = m0 + eff["blade_deflection"] * m1 * float(q_static[_FLAP])
             per_wy = j_hub.T @ np.array([0.0, -g_f, 0.0]) + r_tt.T @ np.array([0.0, g_m, 0.0])
             per_wz = j_hub.T @ np.array([0.0, 0.0, -g_f]) + r_tt.T @ np.array([0.0, 0.0, g_m])
             per_wy[_CYCLIC[0]] += flap.thrust_shape * w_t * g_t

@@ -30,6 +30,7 @@ from .aero import (
     blade_inplane_gain,
     blade_inplane_sensitivity,
     inclined_rotor_inplane,
+    inclined_rotor_moment,
     inplane_ring_weights,
     rotor_coefficients,
     rotor_table,
@@ -795,7 +796,10 @@ class Simulator:
         self.x_eq = self._equilibrium()
         if par[P_SSKEW] > 0.0:  # the skew gains at the inclination the equilibrium holds, then its share in it
             theta0 = float(st.tower_top_rotation[1] @ self.x_eq[:N_DOF])
-            par[P_SKT], par[P_SKM], par[P_SKF] = skew_gains(self.case.wind_speed, theta0 - d.shaft_tilt_rad)
+            par[P_SKT], _, par[P_SKF] = skew_gains(self.case.wind_speed, theta0 - d.shaft_tilt_rad)
+            # the moment from AeroDyn (skewed wake, cone), at the equilibrium's flap deflection
+            m0, m1 = inclined_rotor_moment(self.case.wind_speed)
+            par[P_SKM] = m0 + float(eff["blade_deflection"]) * m1 * float(self.x_eq[FLAP])
             self.x_eq = self._equilibrium()
 
     # ------------------------------------------------------------------------------------------ helpers
