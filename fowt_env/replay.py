@@ -298,9 +298,10 @@ def _run(inp: _ReplayInputs, init: dict[str, float] | None, *, dt: float, seed: 
 
 
 def _fit_initial(inp: _ReplayInputs, base: dict[str, float], span: float, seed: int) -> dict[str, float]:
-    """Gauss-Newton on the platform's initial positions and rates: the replay's platform series against the
-    record's over ``span`` seconds, each channel scaled by its std there (two iterations, a step kept only if it
-    lowers the misfit)."""
+    """Gauss-Newton on the platform's initial positions and rates from the record's first sample and its slopes:
+    the replay's platform series against the record's over ``span`` seconds, each channel scaled by its std there
+    and its mean misfit removed (a model's steady offset, e.g. the mean yaw, is no initial-state error and would
+    otherwise pull every other DOF); up to three iterations, a step kept only if it lowers the misfit."""
     rec = inp.record
     t = np.asarray(rec.t, float)
     span = float(min(span, t[-1] - t[0]))
@@ -310,18 +311,18 @@ def _fit_initial(inp: _ReplayInputs, base: dict[str, float], span: float, seed: 
     sel = np.flatnonzero(t <= t[0] + span)[:: max(1, int(round(0.5 / float(rec.dt))))]  # ~2 Hz
     ref = np.column_stack([np.asarray(rec[c], float)[sel] for c in channels])
     scale = np.maximum(ref.std(axis=0), np.array([_FIT_STEPS[c][0] for c in channels]))
+    params = [(c, _FIT_STEPS[c][0]) for c in channels] + [(_RATE_OF[c], _FIT_STEPS[c][1]) for c in channels]
 
     def residual(init: dict[str, float]) -> NDArray[np.float64]:
         sim = _run(inp, init, dt=0.05, seed=seed, transient=0.0, duration=span)
         st = np.asarray(sim.t, float)
         mod = np.column_stack([np.interp(t[sel], st, np.asarray(sim[c], float)) for c in channels])
-        return ((mod - ref) / scale).ravel()
+        err = mod - ref
+        return ((err - err.mean(axis=0)) / scale).ravel()
 
-    params = [(c, step[0]) for c, step in ((c, _FIT_STEPS[c]) for c in channels)]
-    params += [(_RATE_OF[c], _FIT_STEPS[c][1]) for c in channels]
     best = dict(base)
     r_best = residual(best)
-    for _ in range(2):
+    for _ in range(3):
         jac = np.empty((r_best.size, len(params)))
         for j, (name, step) in enumerate(params):
             trial = dict(best)
@@ -351,8 +352,9 @@ def replay_initial_state(record: Any, *, case: Mapping[str, Any] | None = None, 
     them (OpenFAST's steady-wind run replayed from its first sample: 1.5x OpenFAST's surge below 0.05 Hz 100-300 s
     later). This estimates the initial positions and rates of the platform DOFs the record has by least squares:
     the replay's platform series against the record's over the first `span` seconds (a smoother of the initial
-    state, Gauss-Newton with finite differences, 2 x 12 short replays). Everything after `span` is untouched by the
-    fit, so a replay that discards its first `span` seconds is scored out of sample.
+    state, Gauss-Newton with finite differences, up to 3 x 12 short replays, each channel's mean misfit removed).
+    Everything after `span` is untouched by the fit, so a replay that discards its first `span` seconds is scored
+    out of sample.
 
     Parameters
     ----------
