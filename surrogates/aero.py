@@ -362,8 +362,6 @@ def blade_inplane_gain(wind_speed: float) -> float:
     >>> round(blade_inplane_gain(12.0) / 1e3, 1)
     9.2
     """
-    if not np.isfinite(wind_speed) or wind_speed <= 0:
-        raise ValueError(f"wind_speed must be a positive finite number (m/s), got {wind_speed!r}")
     return float(blade_inplane_sensitivity(round(float(wind_speed), 2))[1].sum())
 
 

@@ -79,6 +79,22 @@ def turbsim_input(template: str, v: float, seed: int) -> str:
     return "\n".join(lines)
 
 
+def working_copy(shared: Path, work: Path, openfast_build: Path) -> dict[str, str]:
+    """Copy the shared decks and tools into `work` (once), compile the DISCON controller there (once) and return the
+    environment for ``run_case.sh``: one BLAS thread, ``OPENFAST`` the build tree's executable."""
+    ref = shared / "reference" / "openfast"
+    for sub in ("decks", "tools"):
+        if not (work / sub).is_dir():
+            shutil.copytree(ref / sub, work / sub)
+    (work / "runs").mkdir(exist_ok=True)
+    servo = work / "decks" / "5MW_Baseline" / "ServoData"
+    if not (servo / "DISCON_OC3Hywind.dll").is_file():
+        subprocess.run(["gfortran", "-shared", "-fPIC", "-O2", "-cpp", "-ffree-line-length-none",
+                        "DISCON_OC3Hywind.f90", "-o", "DISCON_OC3Hywind.dll"], cwd=servo, check=True)
+    return {**os.environ, "OPENBLAS_NUM_THREADS": "1",
+            "OPENFAST": str(openfast_build / "glue-codes" / "openfast" / "openfast")}
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--openfast-build", required=True, type=Path, help="cmake build tree (openfast, turbsim)")
@@ -89,20 +105,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--runs", nargs="+", default=list(RUNS), choices=list(RUNS))
     args = ap.parse_args(argv)
 
-    ref = args.shared / "reference" / "openfast"
     work: Path = args.work
-    for sub in ("decks", "tools"):
-        if not (work / sub).is_dir():
-            shutil.copytree(ref / sub, work / sub)
-    (work / "runs").mkdir(exist_ok=True)
-    servo = work / "decks" / "5MW_Baseline" / "ServoData"
-    if not (servo / "DISCON_OC3Hywind.dll").is_file():
-        subprocess.run(["gfortran", "-shared", "-fPIC", "-O2", "-cpp", "-ffree-line-length-none",
-                        "DISCON_OC3Hywind.f90", "-o", "DISCON_OC3Hywind.dll"], cwd=servo, check=True)
+    env = working_copy(args.shared, work, args.openfast_build)
     wind_dir = work / "decks" / "5MW_Baseline" / "Wind"
     template = (wind_dir / "NTM_B_18mps_s1801_700s.inp").read_text()
-    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1",
-           "OPENFAST": str(args.openfast_build / "glue-codes" / "openfast" / "openfast")}
 
     sys.path.insert(0, str(work / "tools"))
     import make_runs  # the shared run generator (its deck paths resolve inside the working copy)

@@ -39,10 +39,7 @@ run again.
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
-import os
-import shutil
 import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
@@ -74,14 +71,6 @@ CHANNELS = ("PtfmSurge", "PtfmSway", "PtfmHeave", "PtfmRoll", "PtfmPitch", "Ptfm
 FS_OUT = 10.0
 
 
-def sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with path.open("rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--openfast-build", required=True, type=Path, help="cmake build tree (openfast)")
@@ -91,24 +80,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default=DEFAULT_OUT, type=Path)
     args = ap.parse_args(argv)
 
-    ref = args.shared / "reference" / "openfast"
-    work: Path = args.work
-    for sub in ("decks", "tools"):
-        if not (work / sub).is_dir():
-            shutil.copytree(ref / sub, work / sub)
-    (work / "runs").mkdir(exist_ok=True)
-    servo = work / "decks" / "5MW_Baseline" / "ServoData"
-    if not (servo / "DISCON_OC3Hywind.dll").is_file():
-        subprocess.run(["gfortran", "-shared", "-fPIC", "-O2", "-cpp", "-ffree-line-length-none",
-                        "DISCON_OC3Hywind.f90", "-o", "DISCON_OC3Hywind.dll"], cwd=servo, check=True)
-    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1",
-           "OPENFAST": str(args.openfast_build / "glue-codes" / "openfast" / "openfast")}
-    sys.path.insert(0, str(work / "tools"))
-    import make_runs  # the shared run generator (its deck paths resolve inside the working copy)
-
     sys.path.insert(0, str(REPO))
     sys.path.insert(0, str(REPO / "tools"))
-    from compact_openfast_reference import compact
+    from compact_openfast_reference import compact, sha256
+    from openfast_heldout_runs import working_copy
+
+    work: Path = args.work
+    env = working_copy(args.shared, work, args.openfast_build)
+    sys.path.insert(0, str(work / "tools"))
+    import make_runs  # the shared run generator (its deck paths resolve inside the working copy)
 
     from fowt_env import validation
     from fowt_env.io import load_record
