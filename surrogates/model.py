@@ -333,7 +333,7 @@ class FOWTModel:
             if not np.isfinite(v) or v < 0:
                 raise ValueError(f"harmonics.{f} must be finite and >= 0, got {v!r}")
         self.noise.std([])  # validates
-        self._systems: dict[tuple[LoadCase | None, bool], LinearSystem] = {}
+        self._systems: dict[tuple[LoadCase | None, bool, float | None], LinearSystem] = {}
 
     # ------------------------------------------------------------------------------------------- effects
     @property
@@ -400,17 +400,23 @@ class FOWTModel:
         """
         return self._system(case, nonlinear_rotor=False)
 
-    def _system(self, case: int | LoadCase | None, nonlinear_rotor: bool) -> LinearSystem:
+    def _system(self, case: int | LoadCase | None, nonlinear_rotor: bool,
+                mean_pitch: float | None = None) -> LinearSystem:
         """The linear system, or (``nonlinear_rotor``) its structural part for the simulation's nonlinear rotor:
-        no linearised aerodynamic or controller terms, the rotor speed and thrust evaluated per step instead."""
+        no linearised aerodynamic or controller terms, the rotor speed and thrust evaluated per step instead.
+        ``mean_pitch`` (rad): the mean platform pitch at which the pitched platform's terms are formed (the
+        fixed-axes hydrodynamics, the tilted yaw's gravity stiffness, the Euler-angle output rows); default the
+        pitch of the linear model's static deflection under the operating point's thrust."""
         lc = _as_case(case)
         operating = lc is not None and lc.wind_speed > 0 and lc.rotor_rpm > 0
-        key = (lc, bool(nonlinear_rotor and operating))
+        pitch_key = None if mean_pitch is None else round(float(mean_pitch), 9)
+        key = (lc, bool(nonlinear_rotor and operating), pitch_key)
         if key not in self._systems:
-            self._systems[key] = self._assemble(lc, key[1])
+            self._systems[key] = self._assemble(lc, key[1], pitch_key)
         return self._systems[key]
 
-    def _assemble(self, lc: LoadCase | None, nonlinear_rotor: bool = False) -> LinearSystem:  # noqa: C901
+    def _assemble(self, lc: LoadCase | None, nonlinear_rotor: bool = False,  # noqa: C901
+                  mean_pitch_override: float | None = None) -> LinearSystem:
         st = self.structure
         eff = self._effects
         s_aero, s_gyro, s_pd = eff["aero_damping"], eff["gyroscopic"], eff["p_delta"]
@@ -432,7 +438,7 @@ class FOWTModel:
         # thrust holds, the spar's own yaw is also a fixed-axes roll (surrogates.hydro_axes)
         f_static = st.gravity_load + (h_v * op.thrust + r_s * op.generator_torque_lss if op is not None else 0.0)
         q_static = np.linalg.solve(k, f_static)
-        mean_pitch = float(q_static[4])
+        mean_pitch = float(q_static[4]) if mean_pitch_override is None else float(mean_pitch_override)
         # the weights under that pitch: the platform's own yaw y turns the tower's lateral axis by y sin(pitch) out
         # of the horizontal, so a lateral deflection d (platform axes) raises a mass m by d y sin(pitch) (ElastoDyn's
         # exact kinematics; the p_delta family of geometric stiffness)

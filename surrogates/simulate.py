@@ -32,12 +32,13 @@ from .aero import (
     inclined_rotor_inplane,
     inclined_rotor_moment,
     inplane_ring_weights,
+    operating_point,
     rotor_coefficients,
     rotor_table,
     skew_gains,
 )
 from .channels import ALL_CHANNELS, UNITS
-from .controller import DISCON, N_CONTROLLER_STATE, discon_step, initial_controller_state
+from .controller import DISCON, N_CONTROLLER_STATE, discon_step, initial_controller_state, steady_state
 from .controller import PARAMS as DISCON_PARAMS
 from .drag import N_STRIPS, drag_strips
 from .load_cases import LoadCase
@@ -61,7 +62,15 @@ from .structure import _CYCLIC, N_DOF
 from .structure import _FLAP as FLAP
 from .validation import check_number
 from .waves import synthesize_waves
-from .wind import TURBSIM_GRID_SPACING, RotorWind, constrain_to_hub, hub_series, synthesize_rotor_wind
+from .wind import (
+    TURBSIM_GRID_SPACING,
+    RotorWind,
+    constrain_to_hub,
+    hub_series,
+    kaimal_spectrum,
+    rotor_averaging,
+    synthesize_rotor_wind,
+)
 
 
 def mean_shear_z(wind_speed: float, exponent: float = 0.2, hub_height: float = 90.0, radius: float = 63.0) -> float:
@@ -670,6 +679,53 @@ def _discretise(sys: LinearSystem, dt: float) -> _Discrete:
     return _Discrete(np.ascontiguousarray(phi), g_ex0, g_ex1, np.ascontiguousarray(gam1[:, N_EX:]))
 
 
+@functools.lru_cache(maxsize=1)
+def _steady_thrust_curve() -> tuple[np.ndarray, np.ndarray]:
+    """The controlled rotor's steady thrust (N) on a grid of wind speeds (m/s), 3-30 m/s."""
+    winds = np.linspace(3.0, 30.0, 109)
+    return winds, np.array([operating_point(float(v)).thrust for v in winds])
+
+
+@functools.lru_cache(maxsize=256)
+def turbulent_thrust_ratio(wind_speed: float, turbulence_intensity: float, axial_share: float = 1.0) -> float:
+    """Mean thrust of the controlled rotor in turbulent wind over its steady thrust at the mean wind (-).
+
+    The steady thrust curve ``T(v)`` (:func:`surrogates.aero.operating_point`: the controller's steady state at
+    each wind) averaged over a Gaussian rotor-effective wind of mean ``V`` and the standard deviation of the
+    disc-averaged IEC Kaimal wind (:func:`surrogates.wind.kaimal_spectrum` times the disc's coherence reduction
+    :func:`surrogates.wind.rotor_averaging`), both met along the shaft (``axial_share`` = cos of the rotor's
+    inclination). The thrust curve peaks at rated wind, so near rated turbulence lowers the mean thrust (0.87 at
+    11.7 m/s, TI 0.17) and above and below rated it raises it slightly (1.02): the platform's mean pitch in
+    OpenFAST's turbulent 12 m/s run is 4.1 deg, in its steady 12 m/s run 4.8 deg.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Mean hub-height wind (m/s), > 0.
+    turbulence_intensity : float
+        Longitudinal turbulence intensity (-), >= 0.
+    axial_share : float
+        Share of the wind met along the shaft (-), in (0, 1].
+
+    Returns
+    -------
+    float
+    """
+    v = check_number("wind_speed", wind_speed, positive=True)
+    ti = check_number("turbulence_intensity", turbulence_intensity)
+    c = check_number("axial_share", axial_share, positive=True)
+    if ti <= 0.0:
+        return 1.0
+    f = np.linspace(5e-4, 2.0, 4000)
+    h2, _ = rotor_averaging(f, v)
+    sigma = float(np.sqrt(np.trapezoid(kaimal_spectrum(f, v, ti) * h2, f)))
+    nodes, weights = np.polynomial.hermite_e.hermegauss(21)
+    winds, thrust = _steady_thrust_curve()
+    steady = float(np.interp(c * v, winds, thrust))
+    mean = float(np.sum(weights * np.interp(c * np.maximum(v + sigma * nodes, 0.0), winds, thrust)) / weights.sum())
+    return mean / steady if steady > 0 else 1.0
+
+
 class Simulator:
     """Everything that does not depend on the seed: discretised system, nonlinear-effect tables, outputs.
 
@@ -705,6 +761,22 @@ class Simulator:
         self.nonlinear_rotor = eff["rotor_nonlinear"] > 0
         self.system = model._system(self.case, nonlinear_rotor=self.nonlinear_rotor)
         self.nonlinear_rotor = self.nonlinear_rotor and self.system.op is not None
+        self._build()
+        if self.nonlinear_rotor:
+            # the pitched platform's terms (fixed-axes hydrodynamics, the tilted yaw's gravity stiffness) at the
+            # mean pitch this simulation will hold, not the linear model's (4.2 against 4.8 deg in steady 12 m/s
+            # wind: the aligned rotor's operating point) -- OpenFAST's operating yaw mode sits where the mean
+            # pitch puts it (0.092 Hz at 4.9 deg without aerodynamics, 0.130 Hz upright)
+            pitch = self.mean_operating_pitch()
+            if abs(pitch - self.system.mean_pitch) > 1e-4:
+                self.system = model._system(self.case, nonlinear_rotor=True, mean_pitch=pitch)
+                self._build()
+
+    def _build(self) -> None:
+        """Everything that follows from ``self.system``: the discretisation, the nonlinear tables and parameters,
+        the equilibrium and the controller's steady state."""
+        model = self.model
+        eff = model.effects
         disc = _discretise(self.system, self.dt_int)
         self.phi, self.g_ex0, self.g_ex1, self.g_rest = disc.phi, disc.g_ex0, disc.g_ex1, disc.g_rest
         self.cy = np.ascontiguousarray(self.system.C)
@@ -802,6 +874,23 @@ class Simulator:
             par[P_SKM] = m0 + float(eff["blade_deflection"]) * m1 * float(self.x_eq[FLAP])
             self.x_eq = self._equilibrium()
 
+    def mean_operating_pitch(self) -> float:
+        """Mean platform pitch (rad) of a simulation of this load case: the equilibrium's (the controller's steady
+        state with the simulation's rotor) in steady wind; in turbulent wind the parked pitch plus the thrust's
+        share of the equilibrium's, times :func:`turbulent_thrust_ratio` (the pitch follows the mean thrust).
+        Against the simulations' own means (8 seeds, OpenFAST's shared runs' conditions): 2.68 / 2.63 deg at
+        8.2 m/s, 4.33 / 4.07 at 11.7 m/s, 2.83 / 2.77 at 17.8 m/s, 4.89 / 4.75 in steady 12 m/s wind with waves."""
+        pitch = float(self.x_eq[4])
+        lc = self.case
+        if lc is None or lc.wind_speed <= 0 or lc.turbulence_intensity <= 0:
+            return pitch
+        rest = float(self.model._system(None, nonlinear_rotor=False).mean_pitch)
+        st = self.system.structure
+        chi = float(st.tower_top_rotation[1] @ self.x_eq[:N_DOF]) - st.data.shaft_tilt_rad
+        ratio = turbulent_thrust_ratio(round(float(lc.wind_speed), 4), round(float(lc.turbulence_intensity), 5),
+                                       round(math.cos(chi), 5))
+        return rest + (pitch - rest) * ratio
+
     # ------------------------------------------------------------------------------------------ helpers
     def _mooring_linearisation(self, zf: float) -> tuple[np.ndarray, np.ndarray]:
         """Generalised mooring load at zero offset and its Jacobian (central differences on the same table)."""
@@ -837,25 +926,89 @@ class Simulator:
         return u, domega
 
     def _equilibrium(self) -> np.ndarray:
-        """Static equilibrium under the mean loads, the mean rotor loads and the static nonlinear forces."""
-        a_qq = self.system.A[N_DOF:2 * N_DOF, :N_DOF]
-        b_c = self.system.B[N_DOF:2 * N_DOF, 0]
-        b_rest = self.system.B[N_DOF:2 * N_DOF, N_EX:]
-        b_ex = self.system.B[N_DOF:2 * N_DOF, 1:N_EX]
+        """Static equilibrium under the mean loads, the mean rotor loads and the static nonlinear forces.
+
+        With the nonlinear rotor the controller's steady state is solved with it: the blade pitch (above rated) or
+        the rotor speed (below rated) at which the rotor's aerodynamic torque -- at the equilibrium's inclination,
+        flap deflection and sampled shear, as the simulation's rotor meets them -- balances the torque law
+        (:func:`surrogates.controller.steady_state`), alternating with the structure's equilibrium under the
+        loads of that state until both hold. The load case's operating point (``system.op``) is the aligned,
+        straight-bladed rotor's: at 12 m/s its pitch is 3.1 deg and its thrust 601 kN, while the rotor tilted 9 deg
+        by the shaft and the platform's pitch, with bent blades, settles at about 1.3 deg and takes more thrust,
+        so that a simulation started from the operating point's equilibrium drifts 0.6 deg in pitch and a few
+        metres in surge during its first minutes (OpenFAST's steady 12 m/s run: pitch 4.8 deg, blade pitch 1.3
+        deg). ``self.ctrl0`` is set to that steady state (the DLL's state on a first call at that speed and pitch).
+        """
+        inputs = self._equilibrium_inputs()
+        x = self._structural_equilibrium(inputs, np.zeros(N_STATE))
+        if not (self.nonlinear_rotor and self.system.op is not None and self.case is not None):
+            return x
+        n_gear = float(self.par[P_NGEAR])
+        omega0 = float(self.system.rotor_speed)
+        state = (omega0 + float(x[2 * N_DOF]), float(self.ctrl0[2]))
+        for _ in range(12):
+            ss = steady_state(functools.partial(self._aero_torque_at, inputs, x.copy()),
+                              float(self.case.wind_speed), n_gear)
+            self.ctrl0[:N_CONTROLLER_STATE] = initial_controller_state(n_gear * ss.rotor_speed, ss.pitch)
+            x[2 * N_DOF] = ss.rotor_speed - omega0
+            x = self._structural_equilibrium(inputs, x)
+            done = abs(ss.rotor_speed - state[0]) < 1e-7 and abs(ss.pitch - state[1]) < 1e-7
+            state = (ss.rotor_speed, ss.pitch)
+            if done:
+                break
+        return x
+
+    def _equilibrium_inputs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The steady inputs of :meth:`_equilibrium`: exogenous sample, strip velocities, blade winds, azimuths."""
         u_ex = np.zeros((1, N_EX))
         u_ex[0, 0] = 1.0
         if self.case is not None:
             u_ex[0, INPUT_BLOCKS["hub_wind"].start] = self.case.wind_speed
         u_ex[0, INPUT_BLOCKS["shear"]] = self.mean_shear
         vel = np.zeros((1, self.strip_z.size, 2))
-        harm = self.harm
-        self.harm = harm.copy()
-        self.harm[0] = 0.0  # the mean of the harmonics is zero
         # the blades sample the mean sheared wind as they will in the simulation (its mean tilt and yaw moments and
         # side force: the rotor's asymmetric loads), averaged over a third of a turn (the three blades' period)
         blade = self._steady_blade_wind()
         psis = np.linspace(0.0, 2.0 * np.pi / 3.0, 8, endpoint=False) if blade.shape[0] else np.zeros(1)
-        x = np.zeros(N_STATE)
+        return u_ex, vel, blade, psis
+
+    def _aero_torque_at(self, inputs: tuple, x: np.ndarray, _wind: float, omega: float, pitch: float) -> float:
+        """:meth:`_mean_aero_torque` in the signature of :func:`surrogates.controller.steady_state` (the wind is
+        the case's, in ``inputs``)."""
+        return self._mean_aero_torque(inputs, x, omega, pitch)
+
+    def _mean_aero_torque(self, inputs: tuple, x: np.ndarray, omega: float, pitch: float) -> float:
+        """The rotor's aerodynamic torque (N m, LSS) at state ``x`` with rotor speed ``omega`` (rad/s) and blade
+        pitch ``pitch`` (rad), averaged over the azimuths of ``inputs`` (no generator torque: J domega)."""
+        u_ex, vel, blade, psis = inputs
+        xx = x.copy()
+        xx[2 * N_DOF] = omega - float(self.system.rotor_speed)
+        ctrl = self.ctrl0.copy()
+        ctrl[0] = float(self.par[P_NGEAR]) * omega
+        ctrl[2] = pitch
+        ctrl[3] = 0.0
+        harm = self.harm
+        self.harm = harm.copy()
+        self.harm[0] = 0.0
+        try:
+            domega = np.mean([self.loads(xx, 0, float(p), np.zeros(2), u_ex, vel, ctrl, blade)[1] for p in psis])
+        finally:
+            self.harm = harm
+        return float(self.par[P_J] * domega)
+
+    def _structural_equilibrium(self, inputs: tuple, x0: np.ndarray) -> np.ndarray:
+        """The DOFs' static equilibrium (rates zero) under the loads at the controller state ``self.ctrl0``,
+        from ``x0`` (its rotor-speed state kept)."""
+        u_ex, vel, blade, psis = inputs
+        a_qq = self.system.A[N_DOF:2 * N_DOF, :N_DOF]
+        b_c = self.system.B[N_DOF:2 * N_DOF, 0]
+        b_rest = self.system.B[N_DOF:2 * N_DOF, N_EX:]
+        b_ex = self.system.B[N_DOF:2 * N_DOF, 1:N_EX]
+        harm = self.harm
+        self.harm = harm.copy()
+        self.harm[0] = 0.0  # the mean of the harmonics is zero
+        x = np.array(x0, dtype=float)
+        x[N_DOF:2 * N_DOF] = 0.0
         try:
             for _ in range(300):
                 u = np.mean([self.loads(x, 0, float(p), np.zeros(2), u_ex, vel, self.ctrl0.copy(), blade)[0]
@@ -952,7 +1105,7 @@ class Simulator:
         The disc is tilted by the shaft tilt plus the equilibrium pitch of the tower top (~9-10 deg at rated):
         its upper half sits downwind of the centre and its lower half upwind, by ``r cos(psi) sin(chi)``, and a
         frozen field advected at the mean speed ``U`` reaches each point that much later or earlier. At the
-        radius of the radius-weighted blade wind (``BLADE_SAMPLING_RADIUS``, 0.75 R) that is +-0.6 s at 12 m/s:
+        radius of the radius-weighted blade wind (``BLADE_SAMPLING_RADIUS``, 0.75 R) that is +-0.7 s at 12 m/s:
         OpenFAST's InflowWind samples the field at each blade node's own position, so the rotationally sampled
         turbulence must see the same delays.
 

@@ -81,15 +81,19 @@ def test_flexible_blades_lengthen_the_tower_period_and_make_its_decay_beat():
 @pytest.mark.skipif(not RUNS.is_dir(), reason="needs ../shared/reference/openfast (full OpenFAST outputs)")
 @pytest.mark.parametrize("run", [
     pytest.param("c_op08_Hs2p0_Tp9", marks=pytest.mark.xfail(strict=True, reason=(
-        "measured -12.0 % (2.83 m against 3.21): the flap mode takes the thrust at one fixed centre, where OpenFAST's "
+        "measured -12.8 % (2.80 m against 3.21): the flap mode takes the thrust at one fixed centre, where OpenFAST's "
         "moves outboard at fine pitch (8.6 mm of tip per kN of aerodynamic thrust at 8 m/s, 7.6 at 12 m/s); it was "
-        "-11.6 % until the bent blades' lower thrust (blade_deflection) took another 0.5 %"))),
-    "c_op12_Hs2p5_Tp10"])
+        "-11.6 % until the bent blades' lower thrust (blade_deflection) took another 0.5 %, -12.0 % until the "
+        "equilibrium held the controller's steady state with the inclined rotor"))),
+    "d_steady12_Hs2p5_Tp10"])
 def test_static_tip_deflection_in_operation_is_openfasts(run):
-    """The blades' tip deflection at the operating point against OpenFAST's mean ``OoPDefl1`` (3.21 m at 8 m/s,
-    4.26 m at 12 m/s; not in the packaged records). At 18 m/s (pitch 14 deg) the surrogate's 2.5 m is 46 % above
-    OpenFAST's 1.69 m: its flap mode bends along the shaft, ElastoDyn's along the pitched blade's principal axes.
-    At 8 m/s it is 12.0 % below (a strict xfail: the fixed thrust centre of the flap's modal load)."""
+    """The blades' tip deflection at the equilibrium against OpenFAST's mean ``OoPDefl1`` (3.21 m at 8 m/s, 5.10 m
+    in steady 12 m/s wind; not in the packaged records). In steady wind the equilibrium is the mean; in turbulent
+    wind near rated it is not (OpenFAST's turbulent 12 m/s run: 4.26 m, the mean thrust under turbulence is lower
+    than the steady thrust at the mean wind, ``surrogates.simulate.turbulent_thrust_ratio``). At 18 m/s (pitch
+    14 deg) the surrogate's 2.6 m is 52 % above OpenFAST's 1.69 m: its flap mode bends along the shaft,
+    ElastoDyn's along the pitched blade's principal axes. At 8 m/s it is 12.8 % below (a strict xfail: the fixed
+    thrust centre of the flap's modal load)."""
     from fowt_env.io import load_record
 
     ref = load_record(RUNS / run / f"{run}.outb", unknown_channels="keep")

@@ -46,12 +46,14 @@ def test_bad_wind_for_the_skew_table_is_named(bad):
         skew_gains(bad, 0.1)
 
 
-def _hub_loads(model: surrogates.FOWTModel, case, x: np.ndarray) -> np.ndarray:
+def _hub_loads(model: surrogates.FOWTModel, case, x: np.ndarray, ctrl: np.ndarray | None = None) -> np.ndarray:
+    """Hub loads at state ``x`` and controller state ``ctrl`` (default the model's steady state; pass one to compare
+    two models at the same blade pitch: each model's equilibrium holds its own controller steady state)."""
     sim = Simulator(model, case)
     u_ex = np.zeros((1, N_EX))
     u_ex[0, 0] = 1.0
     vel = np.zeros((1, sim.strip_z.size, 2))
-    u, _ = sim.loads(x, 0, 0.3, np.zeros(2), u_ex, vel, sim.ctrl0.copy())
+    u, _ = sim.loads(x, 0, 0.3, np.zeros(2), u_ex, vel, (sim.ctrl0 if ctrl is None else ctrl).copy())
     return u[I_HUB:I_HUB + 6]
 
 
@@ -63,7 +65,7 @@ def test_an_inclined_rotor_carries_three_halves_of_one_blades_moment_times_the_i
     x = np.zeros_like(sim.x_eq)
     x[4] = math.radians(4.0)  # platform pitch: the top pitches with it (rigid tower)
     theta = float(st.tower_top_rotation[1] @ x[:N_DOF])
-    d = _hub_loads(on, case, x) - _hub_loads(off, case, x)
+    d = _hub_loads(on, case, x, sim.ctrl0) - _hub_loads(off, case, x, sim.ctrl0)
     g_t, g_m, g_f = sim.par[[P_SKT, P_SKM, P_SKF]]
     # ... the table's at the inclination of the equilibrium (found with them: a second pass moves it by ~1e-4)
     inc_eq = float(sim.x_eq[:N_DOF] @ st.tower_top_rotation[1]) - st.data.shaft_tilt_rad
@@ -84,14 +86,14 @@ def test_an_inclined_rotor_carries_three_halves_of_one_blades_moment_times_the_i
     assert d[1] == pytest.approx(1.5 * g_ip * eps0 * w_z, rel=1e-9)
     # bent 5 m downwind, eps grows by 5 eps1 (the bent blades' own share, with blade_deflection on)
     x[10] = 5.0
-    d_bent = _hub_loads(on, case, x) - _hub_loads(off, case, x)
+    d_bent = _hub_loads(on, case, x, sim.ctrl0) - _hub_loads(off, case, x, sim.ctrl0)
     assert d_bent[1] == pytest.approx(1.5 * g_ip * (eps0 + 5.0 * eps1) * w_z, rel=1e-9)
     x[10] = 0.0
     # a yawed rotor: sideways in-plane wind -V sin(yaw) gives a tilt moment and a side force instead (and the
     # cone's vertical force)
     x[4], x[5] = 0.0, math.radians(3.0)
     yaw = float(st.tower_top_rotation[2] @ x[:N_DOF])
-    d = _hub_loads(on, case, x) - _hub_loads(off, case, x)
+    d = _hub_loads(on, case, x, sim.ctrl0) - _hub_loads(off, case, x, sim.ctrl0)
     w_y = -12.0 * math.sin(yaw)
     assert d[4] == pytest.approx(1.5 * g_m * w_y, rel=1e-9)
     w_z = 12.0 * math.sin(-st.data.shaft_tilt_rad)  # the shaft's own tilt still inclines the rotor

@@ -42,6 +42,7 @@ import argparse
 import json
 import subprocess
 import sys
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -72,17 +73,31 @@ FS_OUT = 10.0
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    def case_of(name: str) -> dict:
+        return {"name": name, "wave_dir_deg": 0.0, "hs": 2.5, "tp": 10.0, "gamma": 1.0, "wave_seed": 1201,
+                **CASES[name], "transient_s": 0.0, "duration_s": 400.0,
+                "gamma_note": "SeaState WavePkShp = DEFAULT (IEC 61400-3 rule from Tp/sqrt(Hs))",
+                "source": "tools/openfast_time_domain_runs.py: the shared OC3 deck (OpenFAST v5.0.0, 2895884d), "
+                          "output from t = 0"}
+
+    return run_and_package(argv, __doc__, RUNS, case_of, CHANNELS, DEFAULT_OUT, "tools/openfast_time_domain_runs.py")
+
+
+def run_and_package(argv: list[str] | None, doc: str, runs: dict, case_of: Callable[[str], dict],
+                    channels: tuple[str, ...], default_out: Path, created_by: str) -> int:
+    """The command line of the OpenFAST run tools: build each of ``runs`` (``make_runs.build`` of the shared
+    decks, in a working copy), run those without an ``.outb``, write their ``case.json`` (``case_of(name)``) and
+    :func:`package` them."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--openfast-build", required=True, type=Path, help="cmake build tree (openfast)")
     ap.add_argument("--work", required=True, type=Path, help="working copy of the shared decks and the runs")
     ap.add_argument("--shared", default=DEFAULT_SHARED, type=Path)
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--out", default=DEFAULT_OUT, type=Path)
+    ap.add_argument("--out", default=default_out, type=Path)
     args = ap.parse_args(argv)
 
     sys.path.insert(0, str(REPO))
     sys.path.insert(0, str(REPO / "tools"))
-    from compact_openfast_reference import compact, sha256
     from openfast_heldout_runs import working_copy
 
     work: Path = args.work
@@ -90,33 +105,38 @@ def main(argv: list[str] | None = None) -> int:
     sys.path.insert(0, str(work / "tools"))
     import make_runs  # the shared run generator (its deck paths resolve inside the working copy)
 
-    from fowt_env import validation
-    from fowt_env.io import load_record
-
     def one(name: str) -> str:
-        make_runs.build(name, RUNS[name])
+        make_runs.build(name, runs[name])
         rd = work / "runs" / name
         if not (rd / f"{name}.outb").is_file():
             subprocess.run(["bash", str(work / "tools" / "run_case.sh"), name], env=env, check=True)
-        case = {"name": name, "wave_dir_deg": 0.0, "hs": 2.5, "tp": 10.0, "gamma": 1.0, "wave_seed": 1201,
-                **CASES[name], "transient_s": 0.0, "duration_s": 400.0,
-                "gamma_note": "SeaState WavePkShp = DEFAULT (IEC 61400-3 rule from Tp/sqrt(Hs))",
-                "source": "tools/openfast_time_domain_runs.py: the shared OC3 deck (OpenFAST v5.0.0, 2895884d), "
-                          "output from t = 0"}
-        (rd / f"{name}.case.json").write_text(json.dumps(case, indent=1) + "\n")
+        (rd / f"{name}.case.json").write_text(json.dumps(case_of(name), indent=1) + "\n")
         return name
 
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        names = list(pool.map(one, RUNS))
+        names = list(pool.map(one, runs))
+    package(work, names, args.out, channels, created_by)
+    return 0
 
-    out: Path = args.out
+
+def package(work: Path, names: list[str], out: Path, channels: tuple[str, ...], created_by: str) -> None:
+    """Compact copies of the runs ``work/runs/<name>`` in ``out``: records at :data:`FS_OUT` of the ``channels``
+    each run has (constant ones dropped), the case files with the ElastoDyn initial conditions (``start``) and
+    ``summary.json`` with the sha256 of every source and input."""
+    sys.path.insert(0, str(REPO))
+    sys.path.insert(0, str(REPO / "tools"))
+    from compact_openfast_reference import compact, sha256
+
+    from fowt_env import validation
+    from fowt_env.io import load_record
+
     out.mkdir(parents=True, exist_ok=True)
-    summary: dict = {"created_by": "tools/openfast_time_domain_runs.py", "fs_hz": FS_OUT, "runs": {}}
+    summary: dict = {"created_by": created_by, "fs_hz": FS_OUT, "runs": {}}
     for name in names:
         rd = work / "runs" / name
         outb = rd / f"{name}.outb"
         rec = load_record(outb, unknown_channels="keep")
-        chans = [c for c in CHANNELS if c in rec and float(rec[c].std()) > 0.0]
+        chans = [c for c in channels if c in rec and float(rec[c].std()) > 0.0]
         small = compact(rec, chans, FS_OUT, name, f"{name}/{outb.name}")
         small.save(out / f"{name}.npz")
         case = json.loads((rd / f"{name}.case.json").read_text())
@@ -128,7 +148,6 @@ def main(argv: list[str] | None = None) -> int:
             "compact": {"file": f"{name}.npz", "fs_hz": FS_OUT, "channels": chans}}
         print(f"{name}: {len(chans)} channels, {(out / f'{name}.npz').stat().st_size / 1e3:.0f} kB")
     (out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
-    return 0
 
 
 if __name__ == "__main__":
