@@ -334,6 +334,8 @@ class FOWTModel:
                 raise ValueError(f"harmonics.{f} must be finite and >= 0, got {v!r}")
         self.noise.std([])  # validates
         self._systems: dict[tuple[LoadCase | None, bool, float | None], LinearSystem] = {}
+        # per (case, nonlinear rotor): the simulation's mean pitch, equilibrium, controller state and skew gains
+        self._operating_states: dict[tuple[LoadCase | None, bool], tuple] = {}
 
     # ------------------------------------------------------------------------------------------- effects
     @property

@@ -761,7 +761,18 @@ class Simulator:
         self.nonlinear_rotor = eff["rotor_nonlinear"] > 0
         self.system = model._system(self.case, nonlinear_rotor=self.nonlinear_rotor)
         self.nonlinear_rotor = self.nonlinear_rotor and self.system.op is not None
+        # the operating state (mean pitch of the system, equilibrium, controller's steady state, skew gains) is
+        # the same for every Simulator of this model and case: the model keeps it, as it keeps its systems
+        key = (self.case, self.nonlinear_rotor)
+        known = model._operating_states.get(key)
+        if known is not None:
+            pitch, x_eq, ctrl, skew = known
+            if pitch is not None:
+                self.system = model._system(self.case, nonlinear_rotor=True, mean_pitch=pitch)
+            self._build(state=(x_eq, ctrl, skew))
+            return
         self._build()
+        pitch = None
         if self.nonlinear_rotor:
             # the pitched platform's terms (fixed-axes hydrodynamics, the tilted yaw's gravity stiffness) at the
             # mean pitch this simulation will hold, not the linear model's (4.2 against 4.8 deg in steady 12 m/s
@@ -770,11 +781,18 @@ class Simulator:
             pitch = self.mean_operating_pitch()
             if abs(pitch - self.system.mean_pitch) > 1e-4:
                 self.system = model._system(self.case, nonlinear_rotor=True, mean_pitch=pitch)
-                self._build()
+                self._build(warm=(self.x_eq, self.ctrl0))
+            else:
+                pitch = None
+        model._operating_states[key] = (pitch, self.x_eq.copy(), self.ctrl0[:N_CONTROLLER_STATE].copy(),
+                                        self.par[[P_SKT, P_SKF, P_SKM]].copy())
 
-    def _build(self) -> None:
+    def _build(self, warm: tuple[np.ndarray, np.ndarray] | None = None,
+               state: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> None:
         """Everything that follows from ``self.system``: the discretisation, the nonlinear tables and parameters,
-        the equilibrium and the controller's steady state."""
+        the equilibrium and the controller's steady state (its search started from ``warm`` = (state, controller
+        state) when given; taken as they are from ``state`` = (equilibrium, controller state, skew gains), a
+        previous Simulator's of this model and case)."""
         model = self.model
         eff = model.effects
         disc = _discretise(self.system, self.dt_int)
@@ -865,14 +883,21 @@ class Simulator:
         self.mean_shear = np.zeros(2)
         if self.case is not None and self.case.wind_speed > 0:
             self.mean_shear[1] = mean_shear_z(self.case.wind_speed)
-        self.x_eq = self._equilibrium()
+        if state is not None:
+            self.x_eq = np.array(state[0], dtype=float)
+            self.ctrl0[:N_CONTROLLER_STATE] = state[1]
+            par[[P_SKT, P_SKF, P_SKM]] = state[2]
+            return
+        if warm is not None and op is not None:
+            self.ctrl0[:N_CONTROLLER_STATE] = warm[1][:N_CONTROLLER_STATE]
+        self.x_eq = self._equilibrium(None if warm is None else warm[0])
         if par[P_SSKEW] > 0.0:  # the skew gains at the inclination the equilibrium holds, then its share in it
             theta0 = float(st.tower_top_rotation[1] @ self.x_eq[:N_DOF])
             par[P_SKT], _, par[P_SKF] = skew_gains(self.case.wind_speed, theta0 - d.shaft_tilt_rad)
             # the moment from AeroDyn (skewed wake, cone), at the equilibrium's flap deflection
             m0, m1 = inclined_rotor_moment(self.case.wind_speed)
             par[P_SKM] = m0 + float(eff["blade_deflection"]) * m1 * float(self.x_eq[FLAP])
-            self.x_eq = self._equilibrium()
+            self.x_eq = self._equilibrium(self.x_eq)
 
     def mean_operating_pitch(self) -> float:
         """Mean platform pitch (rad) of a simulation of this load case: the equilibrium's (the controller's steady
@@ -925,7 +950,7 @@ class Simulator:
                         self.e_s, self.h_v, self.r_pitch, *self.rotor_grids, self.par, u)
         return u, domega
 
-    def _equilibrium(self) -> np.ndarray:
+    def _equilibrium(self, x0: np.ndarray | None = None) -> np.ndarray:
         """Static equilibrium under the mean loads, the mean rotor loads and the static nonlinear forces.
 
         With the nonlinear rotor the controller's steady state is solved with it: the blade pitch (above rated) or
@@ -940,7 +965,7 @@ class Simulator:
         deg). ``self.ctrl0`` is set to that steady state (the DLL's state on a first call at that speed and pitch).
         """
         inputs = self._equilibrium_inputs()
-        x = self._structural_equilibrium(inputs, np.zeros(N_STATE))
+        x = self._structural_equilibrium(inputs, np.zeros(N_STATE) if x0 is None else x0)
         if not (self.nonlinear_rotor and self.system.op is not None and self.case is not None):
             return x
         n_gear = float(self.par[P_NGEAR])
@@ -951,8 +976,9 @@ class Simulator:
                               float(self.case.wind_speed), n_gear)
             self.ctrl0[:N_CONTROLLER_STATE] = initial_controller_state(n_gear * ss.rotor_speed, ss.pitch)
             x[2 * N_DOF] = ss.rotor_speed - omega0
-            x = self._structural_equilibrium(inputs, x)
             done = abs(ss.rotor_speed - state[0]) < 1e-7 and abs(ss.pitch - state[1]) < 1e-7
+            # the structure to the final tolerance once the controller's state has settled
+            x = self._structural_equilibrium(inputs, x, tol=1e-10 if done else 1e-6)
             state = (ss.rotor_speed, ss.pitch)
             if done:
                 break
@@ -996,9 +1022,9 @@ class Simulator:
             self.harm = harm
         return float(self.par[P_J] * domega)
 
-    def _structural_equilibrium(self, inputs: tuple, x0: np.ndarray) -> np.ndarray:
+    def _structural_equilibrium(self, inputs: tuple, x0: np.ndarray, tol: float = 1e-10) -> np.ndarray:
         """The DOFs' static equilibrium (rates zero) under the loads at the controller state ``self.ctrl0``,
-        from ``x0`` (its rotor-speed state kept)."""
+        from ``x0`` (its rotor-speed state kept), to a relative change of ``tol`` per iteration."""
         u_ex, vel, blade, psis = inputs
         a_qq = self.system.A[N_DOF:2 * N_DOF, :N_DOF]
         b_c = self.system.B[N_DOF:2 * N_DOF, 0]
@@ -1014,7 +1040,7 @@ class Simulator:
                 u = np.mean([self.loads(x, 0, float(p), np.zeros(2), u_ex, vel, self.ctrl0.copy(), blade)[0]
                              for p in psis], axis=0)
                 q_new = -np.linalg.solve(a_qq, b_c + b_ex @ u_ex[0, 1:] + b_rest @ u[N_EX:])
-                done = np.max(np.abs(q_new - x[:N_DOF])) < 1e-10 * (1.0 + np.max(np.abs(q_new)))
+                done = np.max(np.abs(q_new - x[:N_DOF])) < tol * (1.0 + np.max(np.abs(q_new)))
                 x[:N_DOF] = 0.5 * (x[:N_DOF] + q_new)
                 if done:
                     break
