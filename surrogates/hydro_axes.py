@@ -16,9 +16,12 @@ the yaw inertia (about twice the platform's own 1.6e8) and -2.6e7 N m/rad on the
 mode in operation sits at 0.08-0.10 Hz (its records' yaw spectra; the yaw-bearing moment over the yaw angle crosses
 zero there), not at the 0.12 Hz of the parked, untilted spar. The same matrices in the body axes give the
 generalised loads ``T^T X T`` with ``T = diag(I_3, R_y(theta0))``; the difference from ``X`` is what this module
-returns. The mooring is not transformed (MAP++ and the surrogate's table both take the fairleads' true positions),
-nor the viscous drag (Morison strips on the displaced members in both) nor the rigid body's own inertia (exact in
-ElastoDyn).
+returns. Not transformed: the viscous drag (Morison strips on the displaced members in both) and the rigid body's
+own inertia (exact in ElastoDyn). The stiffness is turned as a whole block -- HydroDyn's matrices with the linear
+mooring and the platform weight's restoring that the structure holds in it -- which is what matches OpenFAST: its
+spar turning at 12.1 rpm without aerodynamics, pitched 4.9 deg by a constant load, yaws at 0.092 Hz, this model at
+0.093 Hz; turning HydroDyn's own matrices only would put a mean yaw of -2.9 deg into the steady 12 m/s equilibrium
+(OpenFAST: +0.1 deg).
 
 Whether the true flow around a tilted spar would load its spin like this is another matter (a circular cylinder
 spinning about its axis displaces no water); the surrogate reproduces the referee's model, by name
