@@ -775,7 +775,7 @@ class Simulator:
         pitch = None
         if self.nonlinear_rotor:
             # the pitched platform's terms (fixed-axes hydrodynamics, the tilted yaw's gravity stiffness) at the
-            # mean pitch this simulation will hold, not the linear model's (4.2 against 4.8 deg in steady 12 m/s
+            # mean pitch this simulation will hold, not the linear model's (4.2 against 4.9 deg in steady 12 m/s
             # wind: the aligned rotor's operating point) -- OpenFAST's operating yaw mode sits where the mean
             # pitch puts it (0.092 Hz at 4.9 deg without aerodynamics, 0.130 Hz upright)
             pitch = self.mean_operating_pitch()
@@ -958,8 +958,8 @@ class Simulator:
         flap deflection and sampled shear, as the simulation's rotor meets them -- balances the torque law
         (:func:`surrogates.controller.steady_state`), alternating with the structure's equilibrium under the
         loads of that state until both hold. The load case's operating point (``system.op``) is the aligned,
-        straight-bladed rotor's: at 12 m/s its pitch is 3.1 deg and its thrust 601 kN, while the rotor tilted 9 deg
-        by the shaft and the platform's pitch, with bent blades, settles at about 1.3 deg and takes more thrust,
+        straight-bladed rotor's: at 12 m/s its pitch is 3.1 deg and its thrust 601 kN, while the rotor tilted 10 deg
+        by the shaft and the platform's pitch, with bent blades, settles at 0.97 deg and takes more thrust,
         so that a simulation started from the operating point's equilibrium drifts 0.6 deg in pitch and a few
         metres in surge during its first minutes (OpenFAST's steady 12 m/s run: pitch 4.8 deg, blade pitch 1.3
         deg). ``self.ctrl0`` is set to that steady state (the DLL's state on a first call at that speed and pitch).
