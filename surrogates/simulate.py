@@ -14,6 +14,7 @@ the rotor's initial azimuth and the sensor noise -- the same seed gives the same
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
 import os
@@ -998,14 +999,21 @@ class Simulator:
         psis = np.linspace(0.0, 2.0 * np.pi / 3.0, 8, endpoint=False) if blade.shape[0] else np.zeros(1)
         return u_ex, vel, blade, psis
 
-    def _aero_torque_at(self, inputs: tuple, x: np.ndarray, _wind: float, omega: float, pitch: float) -> float:
-        """:meth:`_mean_aero_torque` in the signature of :func:`surrogates.controller.steady_state` (the wind is
-        the case's, in ``inputs``)."""
-        return self._mean_aero_torque(inputs, x, omega, pitch)
+    @contextlib.contextmanager
+    def _mean_harmonics(self):
+        """Within: the rotor harmonics' mean term zeroed (the equilibrium's loads are the mean loads)."""
+        harm = self.harm
+        self.harm = harm.copy()
+        self.harm[0] = 0.0
+        try:
+            yield
+        finally:
+            self.harm = harm
 
-    def _mean_aero_torque(self, inputs: tuple, x: np.ndarray, omega: float, pitch: float) -> float:
+    def _aero_torque_at(self, inputs: tuple, x: np.ndarray, _wind: float, omega: float, pitch: float) -> float:
         """The rotor's aerodynamic torque (N m, LSS) at state ``x`` with rotor speed ``omega`` (rad/s) and blade
-        pitch ``pitch`` (rad), averaged over the azimuths of ``inputs`` (no generator torque: J domega)."""
+        pitch ``pitch`` (rad), averaged over the azimuths of ``inputs`` (no generator torque: J domega); in the
+        signature of :func:`surrogates.controller.steady_state` (the wind is the case's, in ``inputs``)."""
         u_ex, vel, blade, psis = inputs
         xx = x.copy()
         xx[2 * N_DOF] = omega - float(self.system.rotor_speed)
@@ -1013,13 +1021,8 @@ class Simulator:
         ctrl[0] = float(self.par[P_NGEAR]) * omega
         ctrl[2] = pitch
         ctrl[3] = 0.0
-        harm = self.harm
-        self.harm = harm.copy()
-        self.harm[0] = 0.0
-        try:
+        with self._mean_harmonics():
             domega = np.mean([self.loads(xx, 0, float(p), np.zeros(2), u_ex, vel, ctrl, blade)[1] for p in psis])
-        finally:
-            self.harm = harm
         return float(self.par[P_J] * domega)
 
     def _structural_equilibrium(self, inputs: tuple, x0: np.ndarray, tol: float = 1e-10) -> np.ndarray:
@@ -1030,12 +1033,9 @@ class Simulator:
         b_c = self.system.B[N_DOF:2 * N_DOF, 0]
         b_rest = self.system.B[N_DOF:2 * N_DOF, N_EX:]
         b_ex = self.system.B[N_DOF:2 * N_DOF, 1:N_EX]
-        harm = self.harm
-        self.harm = harm.copy()
-        self.harm[0] = 0.0  # the mean of the harmonics is zero
         x = np.array(x0, dtype=float)
         x[N_DOF:2 * N_DOF] = 0.0
-        try:
+        with self._mean_harmonics():  # the mean of the harmonics is zero
             for _ in range(300):
                 u = np.mean([self.loads(x, 0, float(p), np.zeros(2), u_ex, vel, self.ctrl0.copy(), blade)[0]
                              for p in psis], axis=0)
@@ -1044,8 +1044,6 @@ class Simulator:
                 x[:N_DOF] = 0.5 * (x[:N_DOF] + q_new)
                 if done:
                     break
-        finally:
-            self.harm = harm
         return x
 
     def _steady_blade_wind(self) -> np.ndarray:
