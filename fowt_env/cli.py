@@ -388,7 +388,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
         return _cmd_time_domain(args)
     progress = None  # a bar on a terminal, once a step has run 2 s
     rep = validate(args.reference, seeds=args.seeds, duration=args.duration, runs=args.runs, plot_dir=args.plot,
-                   progress=progress, replay=args.replay, constrain_wind=not args.free_wind)
+                   progress=progress, replay=args.replay, wind="synthetic" if args.free_wind else args.wind)
     print(rep.summary(graded_only=not args.all_channels), end="")
     if args.json:
         rep.to_json(args.json)
@@ -1032,10 +1032,13 @@ def build_parser() -> argparse.ArgumentParser:
                          "beside each record, else Wind1VelX) instead of random seeds; adds R² per channel and band "
                          "against OpenFAST with its linear bound (seeds then vary only the initial rotor azimuth; "
                          "--duration is ignored)")
-    vd.add_argument("--free-wind", action="store_true",
-                    help="draw the turbulence at the case's nominal intensity without conditioning it on the record's "
-                         "Wind1VelX (default: the field is drawn given the measured hub wind, which repeats the "
-                         "run's slow gusts)")
+    vd.add_argument("--wind", choices=("inflow", "hub", "synthetic"), default="inflow",
+                    help="what drives each turbulent run's surrogate: 'inflow' (default) the run's own wind field, "
+                         "<run>.inflow.npz beside the record, as OpenFAST saw it (the seeds vary the waves), else "
+                         "'hub'; 'hub' a synthesised field conditioned on the record's Wind1VelX (repeats the run's "
+                         "slow gusts, grades the turbulence model too); 'synthetic' unconditioned, at the nominal "
+                         "intensity")
+    vd.add_argument("--free-wind", action="store_true", help="the same as --wind synthetic")
     vd.add_argument("--time-domain", action="store_true",
                     help="replay each run of REFERENCE from its first sample (records that start at the run's t = 0) "
                          "and print R² of the surrogate's series against OpenFAST's per channel (as 'validate "

@@ -1284,6 +1284,25 @@ def _measured_hub_wind(run: ReferenceRun, case: Any) -> tuple[np.ndarray, np.nda
         return None
 
 
+WIND_SOURCES = ("inflow", "hub", "synthetic")
+"""What drives a turbulent run's surrogate in :func:`validate` without replay (see its ``wind``)."""
+
+
+def _inflow_wind(run: ReferenceRun, case: Any) -> Any:
+    """The run's own wind field (``<run>.inflow.npz`` beside its record) from the run's time 0, or None (no such
+    file, or a case without turbulence)."""
+    if case is None or not (case.wind_speed > 0 and case.turbulence_intensity > 0) or not run.source:
+        return None
+    path = Path(run.source).with_name(f"{run.name}.inflow.npz")
+    if not path.is_file():
+        return None
+    from surrogates.replay import MeasuredWind
+
+    field = MeasuredWind.from_inflow(path)
+    # OpenFAST starts at t = 0 from its deck's initial conditions (case["start"]); TurbSim's field begins earlier
+    return field.window(0.0, None) if field.t[0] < 0.0 < field.t[-1] else field
+
+
 def _simulate_supports_initial() -> bool:
     import surrogates
 
@@ -1521,6 +1540,7 @@ def validate(
     progress: bool | None = False,
     replay: bool = False,
     constrain_wind: bool = True,
+    wind: str = "inflow",
 ) -> ValidationReport:
     """Compare the surrogate with OpenFAST reference runs, channel by channel.
 
@@ -1571,7 +1591,19 @@ def validate(
         spectrum mostly in its few slowest components (the shared 12 m/s run's hub wind carries 1.9x and 1.4x the
         Kaimal density in 0.005-0.02 and 0.02-0.05 Hz, 0.66x in 0.05-0.1 Hz, within 5 % above 0.1 Hz); the
         constraint repeats them while the rotor plane stays random. False: the nominal intensity, unconstrained
-        (a purely statistical comparison).
+        (a purely statistical comparison). Only with ``wind="hub"``, or where ``wind="inflow"`` finds no inflow
+        file.
+    wind : {"inflow", "hub", "synthetic"}
+        Without replay, the wind of each turbulent run's surrogate. ``"inflow"`` (default): the run's own wind
+        field, ``<run>.inflow.npz`` beside the record (the polar grid over the rotor plane that the shared
+        reference folder carries for every turbulent run, what a reduced model needs of the TurbSim file; the
+        packaged runs carry a 5 Hz copy), the same input OpenFAST had, as code-to-code comparisons such as OC3
+        feed every code the same TurbSim file; the seeds then vary the waves and the rotor's azimuth, and the
+        simulation starts at the run's time 0. Without an inflow file it falls back to ``"hub"``. ``"hub"``:
+        a synthesised field, conditioned on the record's ``Wind1VelX`` if ``constrain_wind`` (see there).
+        ``"synthetic"``: a synthesised field at the nominal intensity, unconstrained. The last two also grade the
+        surrogate's turbulence model; ten minutes of one TurbSim draw differ from another's slow content by tens
+        of per cent, which the surge and blade-pitch statistics inherit.
 
     Returns
     -------
@@ -1601,6 +1633,10 @@ def validate(
         model = surrogates.FOWTModel() if heights is None else surrogates.FOWTModel(gauge_heights=heights)
         model = model.with_effects(rotor_1p=0.0)  # the reference deck's rotor is balanced: no 1P loads
     seed_list = _seed_list(seeds, base_seed)
+    if wind not in WIND_SOURCES:
+        raise ValueError(f"wind must be one of {', '.join(WIND_SOURCES)}, got {wind!r}")
+    if wind == "synthetic":
+        constrain_wind = False
     if duration is not None and not (math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be > 0 s, got {duration!r}")
     ref_runs, skipped = load_reference(reference, runs)
@@ -1617,6 +1653,7 @@ def validate(
                        "del": _DEL_REL, "decay": DECAY_TOLERANCE},
         "replay": bool(replay),
         "constrain_wind": bool(constrain_wind) and not replay,
+        "wind": "replay" if replay else wind,
     }
     has_initial = _simulate_supports_initial()
     figs: list[str] = []
@@ -1658,7 +1695,12 @@ def validate(
                 # start-up: a run whose platform starts away from its equilibrium still rings in its record
                 start = run.case.get("start") if has_initial else None
                 extra: dict[str, Any] = {"initial": dict(start)} if start else {}
-                hub = _measured_hub_wind(run, case) if constrain_wind else None
+                field = _inflow_wind(run, case) if wind == "inflow" else None
+                if field is not None:
+                    extra["wind"] = field
+                    report.notes.append(f"{run.name}: the surrogate is driven by the run's own wind field "
+                                        f"({run.name}.inflow.npz; its Wind1VelX rows compare the field with itself)")
+                hub = _measured_hub_wind(run, case) if constrain_wind and field is None else None
                 if hub is not None:
                     extra["hub_wind"] = hub
                     report.notes.append(f"{run.name}: the surrogate's turbulence is conditioned on the record's "

@@ -60,6 +60,7 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -607,6 +608,27 @@ class MeasuredWind:
     def mean_speed(self) -> float:
         """Mean hub-height wind (m/s)."""
         return float(np.mean(self.hub))
+
+    def window(self, t0: float | None = None, t1: float | None = None) -> MeasuredWind:
+        """The wind between ``t0`` and ``t1`` (s, inclusive; None: from the start / to the end), e.g. to start a
+        simulation at a reference run's time 0 when its inflow begins earlier.
+
+        Raises
+        ------
+        ValueError
+            If fewer than two samples fall in the window.
+        """
+        keep = np.ones(self.t.shape, dtype=bool)
+        if t0 is not None:
+            keep &= self.t >= float(t0) - 1e-9
+        if t1 is not None:
+            keep &= self.t <= float(t1) + 1e-9
+        if int(keep.sum()) < 2:
+            raise ValueError(f"wind: fewer than two samples in [{t0}, {t1}] s (the wind spans "
+                             f"{self.t[0]:g}-{self.t[-1]:g} s)")
+        cut = {name: (None if getattr(self, name) is None else getattr(self, name)[keep])
+               for name in ("t", "hub", "rotor_effective", "shear_y", "shear_z", "blade", "blade_inplane")}
+        return dataclasses.replace(self, **cut)
 
 
 def record_wind_plane(meta: Mapping[str, Any] | None) -> float | None:

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.signal import csd, welch
@@ -135,8 +137,8 @@ def test_simulate_hub_wind_sets_wind1velx_and_leaves_the_rest_to_the_seed():
 
 # --------------------------------------------------------------------------------------------- validate
 def test_validate_conditions_turbulent_runs_on_their_hub_wind():
-    rep = V.validate(None, seeds=1, duration=60.0, runs=["c_op12"])
-    assert rep.settings["constrain_wind"] is True
+    rep = V.validate(None, seeds=1, duration=60.0, runs=["c_op12"], wind="hub")
+    assert rep.settings["constrain_wind"] is True and rep.settings["wind"] == "hub"
     assert any("conditioned on the record's Wind1VelX" in n for n in rep.notes)
     assert rep.runs[0]["load_case"]["turbulence_intensity"] == pytest.approx(0.1703, abs=1e-3)  # nominal
     free = V.validate(None, seeds=1, duration=60.0, runs=["c_op12"], constrain_wind=False)
@@ -151,4 +153,47 @@ def test_cli_free_wind_switches_the_constraint_off(tmp_path):
     out = tmp_path / "v.json"
     assert main(["validate", "--seeds", "1", "--duration", "30", "--runs", "c_op12", "--free-wind",
                  "--json", str(out)]) == 0
-    assert json.loads(out.read_text())["settings"]["constrain_wind"] is False
+    settings = json.loads(out.read_text())["settings"]
+    assert settings["constrain_wind"] is False and settings["wind"] == "synthetic"
+
+
+# ------------------------------------------------------------------------------------ validate, the run's own field
+def test_validate_drives_turbulent_runs_with_their_inflow_field_by_default():
+    rep = V.validate(None, seeds=1, duration=30.0, runs=["c_op12"])
+    assert rep.settings["wind"] == "inflow"
+    assert any("the run's own wind field" in n for n in rep.notes)
+    assert not any("conditioned on the record's Wind1VelX" in n for n in rep.notes)
+    with pytest.raises(ValueError, match="wind must be one of"):
+        V.validate(None, seeds=1, duration=30.0, runs=["c_op12"], wind="turbsim")
+
+
+def test_inflow_driven_surrogate_follows_openfast_rotor_speed():
+    """Fed the wind OpenFAST saw (its packaged inflow field), from OpenFAST's own start, the surrogate's rotor speed
+    follows OpenFAST's series below rated (8 m/s, where the rotor speed is the wind's integral through the torque
+    law), which a random field cannot: the check that the field is placed at the run's time axis."""
+    from surrogates.replay import MeasuredWind
+
+    run = V.load_reference(None, ["c_op08"])[0][0]
+    case = V.surrogate_case(V._with_measured_inputs(run))
+    field = MeasuredWind.from_inflow(Path(run.source).with_name(f"{run.name}.inflow.npz")).window(0.0)
+    assert field.t[0] >= 0.0 and field.t[0] < 0.25
+    sim = surrogates.simulate(surrogates.FOWTModel(), case, 120.0, 0.1, 0, transient=100.0, noise=False,
+                              wind=field, initial=dict(run.case["start"]))
+    ref = np.interp(sim.t, run.record.t, run.record["RotSpeed"])
+    assert np.corrcoef(ref, sim["RotSpeed"])[0, 1] > 0.9
+    assert np.std(sim["RotSpeed"]) == pytest.approx(np.std(ref), rel=0.15)
+
+
+def test_measured_wind_window():
+    from surrogates.replay import MeasuredWind
+
+    t = np.arange(-5.0, 40.0, 0.5)
+    w = MeasuredWind.from_hub(t, 10.0 + np.sin(t))
+    cut = w.window(0.0, 30.0)
+    assert cut.t[0] == 0.0 and cut.t[-1] == 30.0
+    np.testing.assert_allclose(cut.hub, 10.0 + np.sin(cut.t))
+    assert len(cut.rotor_effective) == len(cut.t)
+    with pytest.raises(ValueError, match="fewer than two samples"):
+        w.window(50.0)
+    with pytest.raises(ValueError, match="shorter than"):  # the series' own checks hold for the window
+        w.window(30.0)

@@ -1,7 +1,7 @@
 """The platform's yaw mode against OpenFAST's yaw free decays, parked and in operation.
 
-The runs are ``tools/openfast_yaw_decay_runs.py``'s (OpenFAST v5.0.0 on the shared OC3 deck, still water, output
-from t = 0), packaged in ``fowt_env/data/openfast_yaw_decay/``: the parked spar released from 5 deg of yaw, and
+The runs are ``tools/openfast_side_decay_runs.py``'s (OpenFAST v5.0.0 on the shared OC3 deck, still water, output
+from t = 0), packaged in ``fowt_env/data/openfast_side_decays/``: the parked spar released from 5 deg of yaw, and
 the turbine operating in steady 12 m/s wind released from 3 deg of yaw at its steady state. The surrogate starts
 from the same ElastoDyn initial conditions.
 
@@ -25,7 +25,7 @@ import surrogates
 from fowt_env.io import load_record
 from fowt_env.validation import DECAY_TOLERANCE, decay_analysis, fit_damped_oscillation
 
-DATA = resources.files("fowt_env") / "data" / "openfast_yaw_decay"
+DATA = resources.files("fowt_env") / "data" / "openfast_side_decays"
 
 
 def _run(name: str):

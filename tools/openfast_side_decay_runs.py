@@ -1,7 +1,7 @@
-"""Make OpenFAST yaw free decays of the OC3 deck, parked and in operation, for the yaw-mode check.
+"""Make OpenFAST yaw and roll free decays of the OC3 deck, parked and in operation, for the side-to-side checks.
 
 What
-    Two runs of the shared OC3 Hywind deck in still water with output from t = 0:
+    Four runs of the shared OC3 Hywind deck in still water with output from t = 0:
 
     ====================  ======================================================================================
     run                   conditions
@@ -12,10 +12,12 @@ What
                           state of the shared steady-wind deck in still water (its mean over 200-300 s: surge
                           23.9 m, heave -0.55 m, roll 0.23 deg, pitch 4.84 deg, tower top 0.45 m downwind,
                           blade pitch 1.28 deg, 12.1 rpm); 250 s
+    rd_parked_roll3       as yd_parked_yaw5, released from 3 deg of roll; 200 s
+    rd_op12_roll2         as yd_op12_yaw3, released from 2 deg more roll than the steady state's (2.23 deg); 250 s
     ====================  ======================================================================================
 
     For each it writes the ``case.json`` sidecar (with the ElastoDyn initial conditions as ``start``), then the
-    compact copy ``fowt_env/data/openfast_yaw_decay/``: records at 10 Hz (anti-alias filtered, float32 precision;
+    compact copy ``fowt_env/data/openfast_side_decays/``: records at 10 Hz (anti-alias filtered, float32 precision;
     :func:`compact_openfast_reference.compact`) and ``summary.json`` with the sha256 of every source and input.
 
 Why
@@ -24,11 +26,13 @@ Why
     load (HydroDyn ``AddF0``) at 0.092 Hz -- HydroDyn applies its matrices to the fixed-axes angles, so the pitched
     spar's own yaw meets the roll added inertia (``hydro_fixed_axes``); and in operation at 0.094 Hz with a damping
     ratio of 0.19 (the rotor's aerodynamic yaw damping). The wave-band side-to-side response in steady wind (roll,
-    sway, yaw at 0.1-0.15 Hz) sits on that mode. ``tests/test_yaw_decay.py`` holds the surrogate to both decays.
+    sway, yaw at 0.1-0.15 Hz) sits on that mode. The roll decays give the roll mode (29.9 s parked, 29.5 s in
+    operation) and how much the pitched platform yaws as it rolls. ``tests/test_yaw_decay.py`` and
+    ``tests/test_roll_decay.py`` hold the surrogate to them.
 
-Usage (maintainer tool, not run by the tests; OpenFAST ~3 and ~5 min on one core, the two in parallel)::
+Usage (maintainer tool, not run by the tests; OpenFAST 3-8 min per run on one core, two in parallel)::
 
-    python tools/openfast_yaw_decay_runs.py --openfast-build /tmp/of/build --work /tmp/ofx [--shared ../shared]
+    python tools/openfast_side_decay_runs.py --openfast-build /tmp/of/build --work /tmp/ofx [--shared ../shared]
 
 ``--openfast-build`` is the cmake build tree of the reference build (``<shared>/reference/openfast/build.sh``;
 the DISCON controller is compiled into the working copy of the decks here). A run whose ``.outb`` exists is not
@@ -42,7 +46,7 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_SHARED = REPO.parent / "shared"
-DEFAULT_OUT = REPO / "fowt_env" / "data" / "openfast_yaw_decay"
+DEFAULT_OUT = REPO / "fowt_env" / "data" / "openfast_side_decays"
 
 STILL = dict(WaveMod=0)
 STEADY_STATE = dict(RotSpeed=12.1, BlPitch=1.28, TTDspFA=0.45, PtfmSurge=23.9, PtfmHeave=-0.55, PtfmRoll=0.23,
@@ -53,6 +57,10 @@ RUNS = {
     "yd_parked_yaw5": dict(TMax=150, TStart=0, wind=None, sea=STILL,
                            ed=dict(GenDOF="False", RotSpeed=0, PtfmYaw=5.0)),
     "yd_op12_yaw3": dict(TMax=250, TStart=0, wind=("steady", 12.0), sea=STILL, ed=dict(STEADY_STATE, PtfmYaw=3.0)),
+    "rd_parked_roll3": dict(TMax=200, TStart=0, wind=None, sea=STILL,
+                            ed=dict(GenDOF="False", RotSpeed=0, PtfmRoll=3.0)),
+    "rd_op12_roll2": dict(TMax=250, TStart=0, wind=("steady", 12.0), sea=STILL,
+                          ed=dict(STEADY_STATE, PtfmRoll=STEADY_STATE["PtfmRoll"] + 2.0)),
 }
 CASES = {
     "yd_parked_yaw5": {
@@ -63,6 +71,14 @@ CASES = {
         "wind_speed": 12.0, "turbulence_intensity": 0.0, "shear_exponent": 0.2,
         "turbulence_model": "steady wind (InflowWind WindType 1), power-law shear exponent 0.2",
         "note": "yaw free decay in operation, still water, from the steady state with 3 deg of yaw"},
+    "rd_parked_roll3": {
+        "wind_speed": 0.0, "initial": {"PtfmRoll": 3.0},
+        "rotor": "parked (GenDOF off, RotSpeed 0), no aerodynamics (CompAero 0, CompInflow 0)",
+        "note": "roll free decay, still water, no wind"},
+    "rd_op12_roll2": {
+        "wind_speed": 12.0, "turbulence_intensity": 0.0, "shear_exponent": 0.2,
+        "turbulence_model": "steady wind (InflowWind WindType 1), power-law shear exponent 0.2",
+        "note": "roll free decay in operation, still water, from the steady state with 2 deg more roll"},
 }
 CHANNELS = ("PtfmSurge", "PtfmSway", "PtfmHeave", "PtfmRoll", "PtfmPitch", "PtfmYaw", "RotSpeed", "BldPitch1",
             "GenPwr", "GenTq", "RotThrust", "TwrBsMyt", "TwrBsMxt", "YawBrTAxp", "YawBrTAyp", "TTDspFA", "TTDspSS",
@@ -77,10 +93,10 @@ def main(argv: list[str] | None = None) -> int:
     def case_of(name: str) -> dict:
         return {"name": name, "wave_dir_deg": 0.0, "hs": 0.0, **CASES[name], "transient_s": 0.0,
                 "duration_s": float(RUNS[name]["TMax"]),
-                "source": "tools/openfast_yaw_decay_runs.py: the shared OC3 deck (OpenFAST v5.0.0, 2895884d), "
+                "source": "tools/openfast_side_decay_runs.py: the shared OC3 deck (OpenFAST v5.0.0, 2895884d), "
                           "still water, output from t = 0"}
 
-    return run_and_package(argv, __doc__, RUNS, case_of, CHANNELS, DEFAULT_OUT, "tools/openfast_yaw_decay_runs.py")
+    return run_and_package(argv, __doc__, RUNS, case_of, CHANNELS, DEFAULT_OUT, "tools/openfast_side_decay_runs.py")
 
 
 if __name__ == "__main__":

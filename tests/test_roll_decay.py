@@ -1,0 +1,83 @@
+"""The platform's roll mode against OpenFAST's roll free decays, parked and in operation.
+
+The runs are ``tools/openfast_side_decay_runs.py``'s (OpenFAST v5.0.0 on the shared OC3 deck, still water, output
+from t = 0), packaged in ``fowt_env/data/openfast_side_decays/``: the parked spar released from 3 deg of roll, and
+the turbine operating in steady 12 m/s wind released from 2 deg more roll than its steady state. The surrogate
+starts from the same ElastoDyn initial conditions.
+"""
+
+from __future__ import annotations
+
+import json
+from importlib import resources
+
+import numpy as np
+import pytest
+
+import surrogates
+from fowt_env.io import load_record
+from fowt_env.validation import DECAY_TOLERANCE, decay_analysis
+
+DATA = resources.files("fowt_env") / "data" / "openfast_side_decays"
+
+
+def _run(name: str):
+    case = json.loads((DATA / f"{name}.case.json").read_text())
+    return load_record(DATA / f"{name}.npz"), case
+
+
+def _model() -> surrogates.FOWTModel:
+    return surrogates.FOWTModel(gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS).with_effects(rotor_1p=0.0)
+
+
+def _operating():
+    rec, case = _run("rd_op12_roll2")
+    lc = surrogates.operating_case(float(case["wind_speed"]), 0.0, 10.0, turbulence_intensity=0.0)
+    sim = surrogates.simulate(_model(), lc, float(case["duration_s"]), 0.05, 0, transient=0.0, noise=False,
+                              initial=case["start"])
+    return rec, sim
+
+
+def test_the_parked_roll_decay_is_openfasts():
+    """Parked, still water: period within 3 % and damping within 25 % (the issue's free-decay criteria); measured
+    29.49 / 29.95 s (-1.5 %), 0.051 / 0.047 (+7 %)."""
+    rec, case = _run("rd_parked_roll3")
+    sim = surrogates.simulate(_model(), None, float(case["duration_s"]), 0.05, 0, transient=0.0, noise=False,
+                              initial=case["initial"])
+    ref = decay_analysis(rec.t, rec["PtfmRoll"])
+    sur = decay_analysis(sim.t, sim["PtfmRoll"])
+    assert 29.0 < ref.period_s < 31.0  # the record is the roll decay
+    assert sur.period_s == pytest.approx(ref.period_s, rel=DECAY_TOLERANCE["period"])
+    assert sur.damping_ratio == pytest.approx(ref.damping_ratio, rel=DECAY_TOLERANCE["damping"])
+
+
+def test_the_operating_roll_decay_is_openfasts():
+    """Operating in steady 12 m/s wind, still water: period within 3 % and damping within 25 % of OpenFAST's over
+    the first three cycles; measured 30.21 / 29.54 s (+2.3 %: parked the surrogate's roll is 1.5 % quicker than
+    OpenFAST's, in operation 2.3 % slower -- the fixed-axes stiffness, see the coupling test), 0.055 / 0.056."""
+    rec, sim = _operating()
+    ref = decay_analysis(rec.t, rec["PtfmRoll"])
+    sur = decay_analysis(sim.t, sim["PtfmRoll"])
+    assert sur.period_s == pytest.approx(ref.period_s, rel=DECAY_TOLERANCE["period"])
+    assert sur.damping_ratio == pytest.approx(ref.damping_ratio, rel=DECAY_TOLERANCE["damping"])
+
+
+@pytest.mark.xfail(strict=True, reason="the pitched platform's roll-yaw stiffness: the surrogate yaws -0.38 deg per "
+                                       "deg of roll where OpenFAST yaws +0.16 (README, Known limits)")
+def test_the_operating_platform_yaws_with_its_roll_as_openfasts():
+    """In the operating roll decay (5-80 s, well below the yaw mode) OpenFAST's yaw follows the roll by +0.16
+    deg/deg (regression slope): the pitched spar's roll and yaw are coupled. The surrogate, which turns its whole
+    platform stiffness block into the fixed axes (``hydro_fixed_axes``), yaws -0.38 deg/deg; with the stiffness
+    left in body axes (the added mass still turned) +0.54. Within 0.1 deg/deg."""
+    rec, sim = _operating()
+
+    def slope(r):
+        t = np.asarray(r.t)
+        m = (t > 5.0) & (t < 80.0)
+        roll = np.asarray(r["PtfmRoll"])[m]
+        yaw = np.asarray(r["PtfmYaw"])[m]
+        roll, yaw = roll - roll.mean(), yaw - yaw.mean()
+        return float(np.dot(yaw, roll) / np.dot(roll, roll))
+
+    assert 0.1 < slope(rec) < 0.2
+    assert slope(sim) == pytest.approx(slope(rec), abs=0.1)
