@@ -82,10 +82,10 @@ EFFECTS: dict[str, Effect] = {
                "below the SWL, rises as the spar tilts, so pitch and roll rates and accelerations force heave "
                "(M z_G (cos(theta) theta'^2 + sin(theta) theta'')) and heave accelerations load pitch and roll; "
                "at a mean tilt, the heave-pitch inertial coupling.", linear=False),
-        Effect("hydro_fixed_axes", "HydroDyn's added mass, hydrostatics and additional damping act in the fixed "
-               "axes: under the mean pitch that the thrust holds, the spar's own yaw is also a fixed-axes roll "
-               "and meets sin^2(pitch) of the roll added inertia and restoring (OpenFAST's yaw mode drops from "
-               "0.12 to ~0.09 Hz at rated wind).", linear=True),
+        Effect("hydro_fixed_axes", "HydroDyn's added mass acts on the fixed-axes angular acceleration: under the "
+               "mean pitch that the thrust holds, the spar's own yaw is also a fixed-axes roll and meets "
+               "sin^2(pitch) of the roll added inertia (OpenFAST's yaw mode drops from 0.12 to ~0.09 Hz at rated "
+               "wind); the restoring stays in the body axes.", linear=True),
         Effect("p_delta", "Gravity geometric softening: the weight of tower and RNA acting through the lateral "
                "displacements of tilt and bending (P-delta).", linear=True),
     )

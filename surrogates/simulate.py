@@ -292,8 +292,9 @@ def sampled_shear_harmonics(wind_speed: float = HARMONICS_WIND_SPEED,
 
 @numba.njit(cache=True, nogil=True)
 def _mooring_generalised(x, gx, gy, gyaw, tab, zf, out):
-    """Mooring loads as generalised forces on the 6 platform DOFs about the SWL reference point: out[6:12]
-    (out[0:6] is scratch: the table's loads about the displaced fairlead centre)."""
+    """Mooring loads as generalised forces on the 6 platform DOFs about the SWL reference point: out[6:12], the
+    forces along the fixed axes and the moments along the platform's roll, pitch and yaw axes (out[0:6] is
+    scratch: the table's loads about the displaced fairlead centre)."""
     dx = x[0] + zf * x[4]
     dy = x[1] - zf * x[3]
     mooring_loads(gx, gy, gyaw, tab, dx, dy, x[5], out[0:6])
@@ -302,9 +303,18 @@ def _mooring_generalised(x, gx, gy, gyaw, tab, zf, out):
     out[6] = fx
     out[7] = fy
     out[8] = fz
-    out[9] = out[3] + ly * fz - lz * fy
-    out[10] = out[4] + lz * fx - lx * fz
-    out[11] = out[5] + lx * fy - ly * fx
+    mx = out[3] + ly * fz - lz * fy  # moments about the fixed axes
+    my = out[4] + lz * fx - lx * fz
+    mz = out[5] + lx * fy - ly * fx
+    # the platform's roll turns about its pitched longitudinal axis and its yaw about its own long axis: a moment
+    # about the fixed axes loads them by its components along them -- the spar's axis R_y(pitch) R_x(roll) e_z for
+    # the yaw, so that the line forces, which act at the fairlead centre on that axis, have no moment about it
+    # whatever the roll (only the lines' spread about the centre does)
+    c, s = math.cos(x[4]), math.sin(x[4])
+    cr, sr = math.cos(x[3]), math.sin(x[3])
+    out[9] = c * mx - s * mz
+    out[10] = my
+    out[11] = s * cr * mx - sr * my + c * cr * mz
 
 
 @numba.njit(cache=True, nogil=True)

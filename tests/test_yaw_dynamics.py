@@ -42,8 +42,12 @@ def test_yaw_inertia_gains_the_roll_added_inertia_times_sin_squared():
     s, c = math.sin(theta), math.cos(theta)
     assert m2[5, 5] - m[5, 5] == pytest.approx(a[3, 3] * s * s, rel=1e-9)  # ~1.9e8 kg m^2 at 4 deg
     assert m2[1, 5] == pytest.approx(a[1, 3] * s, rel=1e-9)  # the sway-roll added mass reaches the yaw
-    assert k2[5, 5] == pytest.approx(k[3, 3] * s * s + k[5, 5] * c * c, rel=1e-9)
-    assert np.allclose(m2, m2.T) and np.all(np.linalg.eigvalsh(k2[3:, 3:]) > 0)
+    assert np.array_equal(k2, k)  # the restoring stays in the body axes
+    assert np.allclose(m2, m2.T) and np.all(np.linalg.eigvalsh(m2) > 0)
+    # the former form turned the restoring too: the roll's stiffness reached the yaw by sin^2
+    _, k2t = platform_in_fixed_axes(m, k, a, theta, turn_stiffness=True)
+    assert k2t[5, 5] == pytest.approx(k[3, 3] * s * s + k[5, 5] * c * c, rel=1e-9)
+    assert k2t[3, 5] == pytest.approx(c * s * (k[3, 3] - k[5, 5]), rel=1e-9)
     m0, k0 = platform_in_fixed_axes(m, k, a, theta, strength=0.0)
     assert np.array_equal(m0, m) and np.array_equal(k0, k)
     # a 7th DOF coupled to the roll by the weights (P-delta) keeps that coupling and gains none with the yaw:
@@ -53,9 +57,9 @@ def test_yaw_inertia_gains_the_roll_added_inertia_times_sin_squared():
     k7[6, 3] = k7[3, 6]
     m7 = np.zeros((7, 7))
     m7[:6, :6], m7[6, 6] = m, 4e5
-    _, k7b = platform_in_fixed_axes(m7, k7, a, theta)
+    _, k7b = platform_in_fixed_axes(m7, k7, a, theta, turn_stiffness=True)
     assert np.array_equal(k7b[6, :], k7[6, :]) and np.array_equal(k7b[:, 6], k7[:, 6])
-    assert np.allclose(k7b[:6, :6], k2)
+    assert np.allclose(k7b[:6, :6], k2t)
     with pytest.raises(ValueError, match="added_mass"):
         platform_in_fixed_axes(m, k, a[:5, :5], theta)
 
