@@ -197,3 +197,16 @@ def test_measured_wind_window():
         w.window(50.0)
     with pytest.raises(ValueError, match="shorter than"):  # the series' own checks hold for the window
         w.window(30.0)
+
+
+def test_cli_wind_hub_is_the_hub_conditioned_field(tmp_path):
+    import json
+
+    from fowt_env.cli import main
+
+    out = tmp_path / "v.json"
+    assert main(["validate", "--seeds", "1", "--duration", "30", "--runs", "c_op12", "--wind", "hub",
+                 "--json", str(out)]) == 0
+    report = json.loads(out.read_text())
+    assert report["settings"]["wind"] == "hub" and report["settings"]["constrain_wind"] is True
+    assert any("conditioned on the record's Wind1VelX" in n for n in report["notes"])

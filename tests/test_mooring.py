@@ -193,3 +193,31 @@ def test_line_one_is_downwind():
     fwd = solve_loads((20.0, 0.0, 0.0, 0.0, 0.0, 0.0))[0]
     back = solve_loads((-20.0, 0.0, 0.0, 0.0, 0.0, 0.0))[0]
     assert back > -fwd > 0
+
+
+@pytest.mark.parametrize("surge, sway, roll, pitch", [(24.5, -0.4, 0.0045, 0.085), (15.0, 3.0, -0.01, 0.05)])
+def test_line_loads_on_the_pitched_platforms_own_axes(table, surge, sway, roll, pitch):
+    """The simulation's generalised mooring loads on the platform's roll and yaw are the moments of the exact
+    catenary solve (:func:`solve_loads`, an independent direct solve of the three lines at the displaced fairleads)
+    about the platform's own axes: the yaw about the spar's axis ``R_y(pitch) R_x(roll) e_z``, the roll about the
+    pitched longitudinal axis. The lines act at the fairlead centre, on the spar's axis, so about that axis only
+    their spread (5.2 m fairlead radius) counts: a few kN m, where the moment about the fixed vertical is 120-190
+    kN m (the mean line force times the fairlead's sideways shift as the spar rolls), which the simulation once
+    took for its yaw."""
+    from scipy.spatial.transform import Rotation
+
+    from surrogates.mooring import FAIRLEAD_Z
+    from surrogates.simulate import N_STATE, _mooring_generalised
+
+    exact = solve_loads(np.array([surge, sway, 0.0, roll, pitch, 0.0]), ref_z=0.0)
+    rot = Rotation.from_euler("ZYX", [0.0, pitch, roll]).as_matrix()  # Rz Ry Rx, as solve_loads turns the platform
+    spar_axis = rot @ np.array([0.0, 0.0, 1.0])
+    roll_axis = Rotation.from_euler("y", pitch).as_matrix() @ np.array([1.0, 0.0, 0.0])
+    x = np.zeros(N_STATE)
+    x[[0, 1, 3, 4]] = surge, sway, roll, pitch
+    out = np.zeros(12)
+    _mooring_generalised(x, table.grid_dx, table.grid_dy, table.grid_yaw, table.table, FAIRLEAD_Z, out)
+    assert abs(exact[5]) > 1e5  # the moment about the fixed vertical is large ...
+    assert abs(spar_axis @ exact[3:]) < 1e4  # ... about the spar's own axis it is not
+    assert out[11] == pytest.approx(spar_axis @ exact[3:], abs=5e3)
+    assert out[9] == pytest.approx(roll_axis @ exact[3:], rel=0.01, abs=1e4)
