@@ -1288,13 +1288,17 @@ WIND_SOURCES = ("inflow", "hub", "synthetic")
 """What drives a turbulent run's surrogate in :func:`validate` without replay (see its ``wind``)."""
 
 
+def _inflow_path(run: ReferenceRun) -> Path | None:
+    """The run's ``<run>.inflow.npz`` beside its record, or None where there is none."""
+    path = Path(run.source).with_name(f"{run.name}.inflow.npz") if run.source else None
+    return path if path is not None and path.is_file() else None
+
+
 def _inflow_wind(run: ReferenceRun, case: Any) -> Any:
-    """The run's own wind field (``<run>.inflow.npz`` beside its record) from the run's time 0, or None (no such
-    file, or a case without turbulence)."""
-    if case is None or not (case.wind_speed > 0 and case.turbulence_intensity > 0) or not run.source:
-        return None
-    path = Path(run.source).with_name(f"{run.name}.inflow.npz")
-    if not path.is_file():
+    """The run's own wind field (:func:`_inflow_path`) from the run's time 0, or None (no such file, or a case
+    without turbulence)."""
+    path = _inflow_path(run)
+    if case is None or not (case.wind_speed > 0 and case.turbulence_intensity > 0) or path is None:
         return None
     from surrogates.replay import MeasuredWind
 
@@ -1505,8 +1509,8 @@ def _replay_operating(run: ReferenceRun, model: Any, seeds: Sequence[int], dt: f
 
     from .replay import inflow_rotor_wind, replay_initial_state, replay_record, replay_scores
 
-    inflow = Path(run.source).with_name(f"{run.name}.inflow.npz") if run.source else None
-    has_inflow = inflow is not None and inflow.is_file()
+    inflow = _inflow_path(run)
+    has_inflow = inflow is not None
     wind = MeasuredWind.from_inflow(inflow) if has_inflow else None  # read once for every seed
     case = _with_measured_inputs(run, realised_ti=True)
     # the platform's state at the record's first sample, fitted over the discarded start-up (out of sample after)

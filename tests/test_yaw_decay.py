@@ -15,33 +15,19 @@ its operating yaw mode was 0.104 Hz with a damping ratio of 0.24.
 
 from __future__ import annotations
 
-import json
-from importlib import resources
-
 import numpy as np
 import pytest
+from side_decays import decay_model, decay_run  # tests/ is on sys.path (pytest prepend mode)
 
 import surrogates
-from fowt_env.io import load_record
 from fowt_env.validation import DECAY_TOLERANCE, decay_analysis, fit_damped_oscillation
-
-DATA = resources.files("fowt_env") / "data" / "openfast_side_decays"
-
-
-def _run(name: str):
-    case = json.loads((DATA / f"{name}.case.json").read_text())
-    return load_record(DATA / f"{name}.npz"), case
-
-
-def _model() -> surrogates.FOWTModel:
-    return surrogates.FOWTModel(gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS).with_effects(rotor_1p=0.0)
 
 
 def test_the_parked_yaw_decay_is_openfasts():
     """Parked, still water: period within 3 % and damping within 25 % (the issue's free-decay criteria); measured
     8.27 s / 8.27 s, 0.045 / 0.045."""
-    rec, case = _run("yd_parked_yaw5")
-    sim = surrogates.simulate(_model(), None, float(case["duration_s"]), 0.0125, 0, transient=0.0, noise=False,
+    rec, case = decay_run("yd_parked_yaw5")
+    sim = surrogates.simulate(decay_model(), None, float(case["duration_s"]), 0.0125, 0, transient=0.0, noise=False,
                               initial=case["initial"])
     ref = decay_analysis(rec.t, rec["PtfmYaw"])
     sur = decay_analysis(sim.t, sim["PtfmYaw"])
@@ -56,9 +42,9 @@ def test_the_operating_yaw_decay_is_openfasts():
     (+21 %); the rotor's aerodynamic yaw damping is the rest (OpenFAST: 0.033 without aerodynamics). With the
     platform's restoring turned into the fixed axes (``surrogates.hydro_axes``'s former form) and the yaw-moment
     gain calibrated on it (0.23): 0.0978 Hz, 0.222."""
-    rec, case = _run("yd_op12_yaw3")
+    rec, case = decay_run("yd_op12_yaw3")
     lc = surrogates.operating_case(float(case["wind_speed"]), 0.0, 10.0, turbulence_intensity=0.0)
-    sim = surrogates.simulate(_model(), lc, 60.0, 0.0125, 0, transient=0.0, noise=False, initial=case["start"])
+    sim = surrogates.simulate(decay_model(), lc, 60.0, 0.0125, 0, transient=0.0, noise=False, initial=case["start"])
     f_ref, z_ref, _ = fit_damped_oscillation(rec.t, rec["PtfmYaw"])
     f_sur, z_sur, _ = fit_damped_oscillation(sim.t, sim["PtfmYaw"])
     assert 0.08 < f_ref < 0.11 and 0.1 < z_ref < 0.3  # the record is the operating decay
@@ -70,7 +56,7 @@ def test_the_operating_yaw_mode_sits_where_the_mean_pitch_puts_it():
     """Formed at the simulation's mean pitch, not at the linear model's: the yaw mode of the structural system the
     simulation steps (its fixed-axes terms) is lower than at the linear model's 4.2 deg, as OpenFAST's is."""
     lc = surrogates.operating_case(12.0, 0.0, 10.0, turbulence_intensity=0.0)
-    model = _model()
+    model = decay_model()
     sim = surrogates.Simulator(model, lc)
     assert np.rad2deg(sim.system.mean_pitch) == pytest.approx(np.rad2deg(sim.x_eq[4]), abs=1e-3)
     assert np.rad2deg(sim.system.mean_pitch) > np.rad2deg(model.system(lc).mean_pitch) + 0.4

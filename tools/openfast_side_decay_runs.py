@@ -62,23 +62,17 @@ RUNS = {
     "rd_op12_roll2": dict(TMax=250, TStart=0, wind=("steady", 12.0), sea=STILL,
                           ed=dict(STEADY_STATE, PtfmRoll=STEADY_STATE["PtfmRoll"] + 2.0)),
 }
+PARKED_CASE = {"wind_speed": 0.0,
+               "rotor": "parked (GenDOF off, RotSpeed 0), no aerodynamics (CompAero 0, CompInflow 0)"}
+STEADY_12_CASE = {"wind_speed": 12.0, "turbulence_intensity": 0.0, "shear_exponent": 0.2,
+                  "turbulence_model": "steady wind (InflowWind WindType 1), power-law shear exponent 0.2"}
 CASES = {
-    "yd_parked_yaw5": {
-        "wind_speed": 0.0, "initial": {"PtfmYaw": 5.0},
-        "rotor": "parked (GenDOF off, RotSpeed 0), no aerodynamics (CompAero 0, CompInflow 0)",
-        "note": "yaw free decay, still water, no wind"},
-    "yd_op12_yaw3": {
-        "wind_speed": 12.0, "turbulence_intensity": 0.0, "shear_exponent": 0.2,
-        "turbulence_model": "steady wind (InflowWind WindType 1), power-law shear exponent 0.2",
-        "note": "yaw free decay in operation, still water, from the steady state with 3 deg of yaw"},
-    "rd_parked_roll3": {
-        "wind_speed": 0.0, "initial": {"PtfmRoll": 3.0},
-        "rotor": "parked (GenDOF off, RotSpeed 0), no aerodynamics (CompAero 0, CompInflow 0)",
-        "note": "roll free decay, still water, no wind"},
-    "rd_op12_roll2": {
-        "wind_speed": 12.0, "turbulence_intensity": 0.0, "shear_exponent": 0.2,
-        "turbulence_model": "steady wind (InflowWind WindType 1), power-law shear exponent 0.2",
-        "note": "roll free decay in operation, still water, from the steady state with 2 deg more roll"},
+    "yd_parked_yaw5": {**PARKED_CASE, "initial": {"PtfmYaw": 5.0}, "note": "yaw free decay, still water, no wind"},
+    "yd_op12_yaw3": {**STEADY_12_CASE,
+                     "note": "yaw free decay in operation, still water, from the steady state with 3 deg of yaw"},
+    "rd_parked_roll3": {**PARKED_CASE, "initial": {"PtfmRoll": 3.0}, "note": "roll free decay, still water, no wind"},
+    "rd_op12_roll2": {**STEADY_12_CASE, "note": "roll free decay in operation, still water, from the steady state "
+                                                "with 2 deg more roll"},
 }
 CHANNELS = ("PtfmSurge", "PtfmSway", "PtfmHeave", "PtfmRoll", "PtfmPitch", "PtfmYaw", "RotSpeed", "BldPitch1",
             "GenPwr", "GenTq", "RotThrust", "TwrBsMyt", "TwrBsMxt", "YawBrTAxp", "YawBrTAyp", "TTDspFA", "TTDspSS",
