@@ -103,7 +103,12 @@ class RotorHarmonics:
     while the tilt moment peaks); yaw 221 kN·m as ``sin 3 psi`` (OpenFAST's phase is 152 deg from it, but with
     that phase this model's 3P platform yaw comes out 3x too large and its fore-aft 3P response 20 % larger:
     the model has no tower torsion); side force 3.7 kN as ``-cos 3 psi`` (OpenFAST: 16 deg from it); torque
-    6.2 kN·m; ``psi = 0`` with blade 1 up. They scale with the mean thrust at other wind speeds. The 1P terms
+    6.2 kN·m; ``psi = 0`` with blade 1 up. They scale with the mean thrust at other wind speeds, except the side
+    force, which follows ``V^2 dQ/dV`` at every step (:func:`surrogates.simulate.side_force_law`): OpenFAST's
+    side-to-side 3P response in steady wind at 8-18 m/s rises above rated while the thrust falls. The side
+    force's 3.7 kN is the 3P amplitude of OpenFAST's tower-top shear force ``YawBrFyp``, a response rather than
+    the rotor's own lateral force (the shaft's ``LSShftFya``: 0.66 kN): an effective side-to-side 3P excitation,
+    whose tower-base response is 0.7-1.2x OpenFAST's at 8-18 m/s (``tests/test_rotor_harmonics.py``). The 1P terms
     are engineering estimates, not in the OpenFAST deck (its rotor is perfectly balanced): a balancing grade of
     the order of ISO G16 and a small pitch misalignment. Each effect's strength scales them.
 
@@ -119,7 +124,8 @@ class RotorHarmonics:
     yaw_moment_3p : float
         Yaw rotor-moment amplitude at 3P, fraction of (mean thrust × rotor radius) (-).
     side_force_3p : float
-        Side (in-plane, horizontal) force amplitude at 3P, fraction of the mean thrust (-).
+        Side (in-plane, horizontal) force amplitude at 3P at the 12 m/s operating point, fraction of its thrust
+        (-); elsewhere scaled by ``V^2 dQ/dV`` (:func:`surrogates.simulate.side_force_law`).
     thrust_1p : float
         1P thrust variation from aerodynamic imbalance, fraction of mean thrust (-).
     moment_1p : float

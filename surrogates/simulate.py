@@ -203,6 +203,25 @@ HARMONICS_SHEAR_EXPONENT = 0.2
 
 
 @functools.lru_cache(maxsize=1)
+def side_force_law() -> float:
+    """The rotor's 3P side force per unit of ``V^2 dQ/dV`` (1/(m s), i.e. N per (m/s)^2 N m s/m), for
+    :attr:`surrogates.model.RotorHarmonics.side_force_3p` = 1.
+
+    The side force's amplitude is ``side_force_3p * T_12 * (V^2 dQ/dV) / (V_12^2 dQ/dV_12)``: the harmonic's
+    fraction of the thrust ``T_12`` at the 12 m/s point where it is defined, carried to any other state by the
+    rotor-normal wind ``V`` and the torque's sensitivity to it ``dQ/dV`` (at constant rotor speed and pitch; from
+    the rotor tables at every step with the nonlinear rotor, at the operating point without). The blades passing
+    the tower lose in-plane (torque) force in proportion to their sensitivity to the wind and to the shadow's
+    deficit, a fixed fraction of the wind; OpenFAST's side-to-side 3P response in steady wind with shear 0.2 at
+    8, 10, 12, 14 and 18 m/s (``tools/openfast_rotor_harmonics_runs.py``) rises as ``V^2 dQ/dV`` does
+    (x8 from 8 to 18 m/s) while the thrust falls above rated: the tower's 3P side-to-side response scaled with the
+    thrust was 2x OpenFAST's at 8 m/s and 0.1x at 18 m/s.
+    """
+    op = operating_point(HARMONICS_WIND_SPEED)
+    return float(op.thrust / (HARMONICS_WIND_SPEED**2 * op.dQ_dV))
+
+
+@functools.lru_cache(maxsize=1)
 def _shear_share() -> dict[str, float]:
     return sampled_shear_harmonics()
 
@@ -382,6 +401,7 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         u[nl0 + 4] += mzg * s_th * ctrl[I_ACC]
     # --- nonlinear rotor: Ct/Cq surfaces at the wind relative to the moving hub, DISCON's torque and pitch
     domega = 0.0
+    side_drive = harm[15]  # V^2 dQ/dV of the 3P side force (m^2/s^2 N m s/m): the operating point's, or below
     if par[P_ROTOR] > 0.0:
         v_hub = 0.0
         theta = 0.0
@@ -416,10 +436,13 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         # differences over +-H_CURV m/s): each blade meets its own wind, and a blade's load is curved in it
         # (sampled_wind_curvature), so the rotor carries 1/3 * 1/2 * d2(load)/dV2 * dv_b^2 per blade beyond the
         # linear blade loads
+        # (the same differences give the torque's sensitivity to the wind, dQ/dV, which sets the 3P side force)
         t_uu = 0.0
         q_uu = 0.0
         s_curv = par[P_SCURV]
-        if s_curv > 0.0:
+        need_dq = harm[0] != 0.0 and harm[12] != 0.0
+        if s_curv > 0.0 or need_dq:
+            dq_dv = 0.0
             for sgn in (-1.0, 1.0):
                 v_c = vn + sgn * H_CURV
                 lam_c = omega * par[P_RADIUS] / max(abs(v_c), 0.1)
@@ -431,8 +454,10 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 q_c = par[P_QAREA] * v_c * abs(v_c)
                 t_uu += q_c * ct_c
                 q_uu += q_c * par[P_RADIUS] * cq_c
+                dq_dv += sgn * q_c * par[P_RADIUS] * cq_c
             t_uu = s_curv * (t_uu - 2.0 * thrust) / (H_CURV * H_CURV) / 6.0
             q_uu = s_curv * (q_uu - 2.0 * q_aero) / (H_CURV * H_CURV) / 6.0
+            side_drive = vn * vn * dq_dv / (2.0 * H_CURV)
         # advancing and retreating blades (rotor_skew): the wind's component in the rotor plane -- up the disc
         # w_z from the shaft's inclination (tilt - pitch, nose up), sideways w_y from the top's yaw, less the hub's
         # own in-plane velocity -- adds w_y cos(psi_b) + w_z sin(psi_b) to blade b's airspeed; with one blade's
@@ -552,7 +577,8 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         u[rot0 + 1] = q_gen_hss
         u[rot0 + 2] = q_gen * omega * par[P_GENEFF]
         u[rot0 + 3] = thrust
-    # --- rotor harmonics: harm = [T0, Q0, R, Omega0, a3, a6, aq, am, a1, b1, mi, am_yaw, a_side]
+    # --- rotor harmonics: harm = [T0, Q0, R, Omega0, a3, a6, aq, am, a1, b1, mi, am_yaw, c_side, (shear shares),
+    #     V0^2 dQ/dV at the operating point]; the side force is c_side V^2 dQ/dV (side_force_law)
     #     (strengths applied). psi = 0: blade 1 up, so cos(3 psi) = -1 when a blade points down, through the
     #     tower's shadow and the slowest wind of the shear: the collective thrust dips while the tilt moment
     #     peaks (anti-phase); side force with the sign OpenFAST shows; yaw: see RotorHarmonics
@@ -573,17 +599,18 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         mq = harm[1] * harm[6] * c3
         tr = t0 * harm[2]
         cent = harm[10] * omega * omega
+        side = harm[12] * side_drive
         for a in range(3):
             u[hub0 + a] += fs * e_s[a]
             u[hub0 + 3 + a] += mq * e_s[a]
         u[rot0 + 3] += fs  # RotThrust carries the harmonic thrust too
-        u[hub0 + 1] += cent * s1 - t0 * harm[12] * c3
+        u[hub0 + 1] += cent * s1 - side * c3
         u[hub0 + 2] += cent * c1
         u[hub0 + 4] += tr * (-am * c3 + harm[9] * c1)
         u[hub0 + 5] += tr * (harm[11] * s3 + harm[9] * s1)
         # the harmonic amplitudes are OpenFAST's shaft loads, measured behind its flexible blades: they act on the
         # hub, not through the blades' flap mode (which the hub-load block would also drive, by h_v[FLAP])
-        f_shaft = fs + (cent * s1 - t0 * harm[12] * c3) * e_s[1] + cent * c1 * e_s[2]
+        f_shaft = fs + (cent * s1 - side * c3) * e_s[1] + cent * c1 * e_s[2]
         u[nl0 + FLAP] -= h_v[FLAP] * f_shaft
     return domega
 
@@ -839,8 +866,10 @@ class Simulator:
         self.harm = np.array([
             op.thrust if op else 0.0, op.aero_torque if op else 0.0, st.data.tip_radius,
             self.system.rotor_speed, s3 * h.thrust_3p, s3 * h.thrust_6p, s3 * h.torque_3p, s3 * h.moment_3p,
-            s1 * h.thrust_1p, s1 * h.moment_1p, s1 * h.mass_imbalance, s3 * h.yaw_moment_3p, s3 * h.side_force_3p,
+            s1 * h.thrust_1p, s1 * h.moment_1p, s1 * h.mass_imbalance, s3 * h.yaw_moment_3p,
+            s3 * h.side_force_3p * side_force_law(),
             0.0, 0.0,  # the sampled shear's share of the 3P thrust and tilt (set with the nonlinear rotor)
+            self.case.wind_speed**2 * op.dQ_dV if op and self.case is not None else 0.0,
         ])
         d = st.data
         par = np.zeros(N_PAR)

@@ -1,7 +1,7 @@
-"""Make OpenFAST yaw and roll free decays of the OC3 deck, parked and in operation, for the side-to-side checks.
+"""Make OpenFAST yaw, roll and tower side-to-side free decays of the OC3 deck, parked and in operation.
 
 What
-    Four runs of the shared OC3 Hywind deck in still water with output from t = 0:
+    Seven runs of the shared OC3 Hywind deck in still water with output from t = 0:
 
     ====================  ======================================================================================
     run                   conditions
@@ -14,6 +14,11 @@ What
                           blade pitch 1.28 deg, 12.1 rpm); 250 s
     rd_parked_roll3       as yd_parked_yaw5, released from 3 deg of roll; 200 s
     rd_op12_roll2         as yd_op12_yaw3, released from 2 deg more roll than the steady state's (2.23 deg); 250 s
+    sd_parked_ss0p3       as yd_parked_yaw5, the tower top released from 0.3 m side-to-side; 60 s
+    sd_op12_ss0p3         as yd_op12_yaw3, the tower top released from 0.3 m side-to-side; 80 s
+    sd_op08_ss0p3         steady 8 m/s wind (shear 0.2), operating in region 2, from near the shared turbulent 8 m/s
+                          run's mean state (9.24 rpm, surge 13.2 m, pitch 2.67 deg) with the tower top 0.3 m
+                          side-to-side; 80 s
     ====================  ======================================================================================
 
     For each it writes the ``case.json`` sidecar (with the ElastoDyn initial conditions as ``start``), then the
@@ -27,8 +32,11 @@ Why
     spar's own yaw meets the roll added inertia (``hydro_fixed_axes``); and in operation at 0.094 Hz with a damping
     ratio of 0.19 (the rotor's aerodynamic yaw damping). The wave-band side-to-side response in steady wind (roll,
     sway, yaw at 0.1-0.15 Hz) sits on that mode. The roll decays give the roll mode (29.9 s parked, 29.5 s in
-    operation) and how much the pitched platform yaws as it rolls. ``tests/test_yaw_decay.py`` and
-    ``tests/test_roll_decay.py`` hold the surrogate to them.
+    operation) and how much the pitched platform yaws as it rolls. The tower's side-to-side decays give its first
+    side-to-side mode parked (0.457 Hz, the rotor locked to the nacelle) and in operation, where the rotor turns
+    free of the nacelle's roll (0.497 Hz at 8 and at 12 m/s, damping 1.0 %): on it sits the 3P resonance of a
+    turbulent 12 m/s run whose rotor drops into region 2 (``tests/test_tower_side_decay.py``).
+    ``tests/test_yaw_decay.py`` and ``tests/test_roll_decay.py`` hold the surrogate to the platform's decays.
 
 Usage (maintainer tool, not run by the tests; OpenFAST 3-8 min per run on one core, two in parallel)::
 
@@ -53,6 +61,10 @@ STEADY_STATE = dict(RotSpeed=12.1, BlPitch=1.28, TTDspFA=0.45, PtfmSurge=23.9, P
                     PtfmPitch=4.84)
 """The shared steady-wind deck's state at 12 m/s in still water (mean over 200-300 s of a run from the deck's
 initial conditions): the operating decay starts there, so that only the yaw is released."""
+STEADY_STATE_8 = dict(RotSpeed=9.24, BlPitch=0.0, TTDspFA=0.25, PtfmSurge=13.2, PtfmHeave=-0.21, PtfmRoll=0.12,
+                      PtfmPitch=2.67)
+"""The 8 m/s operating state (means of the shared turbulent 8 m/s run): the region-2 tower decay starts near it;
+the platform's slow settling is far below the tower mode and is filtered out of the decay."""
 RUNS = {
     "yd_parked_yaw5": dict(TMax=150, TStart=0, wind=None, sea=STILL,
                            ed=dict(GenDOF="False", RotSpeed=0, PtfmYaw=5.0)),
@@ -61,6 +73,9 @@ RUNS = {
                             ed=dict(GenDOF="False", RotSpeed=0, PtfmRoll=3.0)),
     "rd_op12_roll2": dict(TMax=250, TStart=0, wind=("steady", 12.0), sea=STILL,
                           ed=dict(STEADY_STATE, PtfmRoll=STEADY_STATE["PtfmRoll"] + 2.0)),
+    "sd_parked_ss0p3": dict(TMax=60, TStart=0, wind=None, sea=STILL, ed=dict(GenDOF="False", RotSpeed=0, TTDspSS=0.3)),
+    "sd_op12_ss0p3": dict(TMax=80, TStart=0, wind=("steady", 12.0), sea=STILL, ed=dict(STEADY_STATE, TTDspSS=0.3)),
+    "sd_op08_ss0p3": dict(TMax=80, TStart=0, wind=("steady", 8.0), sea=STILL, ed=dict(STEADY_STATE_8, TTDspSS=0.3)),
 }
 PARKED_CASE = {"wind_speed": 0.0,
                "rotor": "parked (GenDOF off, RotSpeed 0), no aerodynamics (CompAero 0, CompInflow 0)"}
@@ -73,6 +88,14 @@ CASES = {
     "rd_parked_roll3": {**PARKED_CASE, "initial": {"PtfmRoll": 3.0}, "note": "roll free decay, still water, no wind"},
     "rd_op12_roll2": {**STEADY_12_CASE, "note": "roll free decay in operation, still water, from the steady state "
                                                 "with 2 deg more roll"},
+    "sd_parked_ss0p3": {**PARKED_CASE, "initial": {"TTDspSS": 0.3},
+                        "note": "tower side-to-side free decay, still water, no wind"},
+    "sd_op12_ss0p3": {**STEADY_12_CASE, "note": "tower side-to-side free decay in operation (region 3), still water, "
+                                                "from the steady state with 0.3 m of tower-top side-to-side"},
+    "sd_op08_ss0p3": {**STEADY_12_CASE, "wind_speed": 8.0,
+                      "turbulence_model": "steady wind (InflowWind WindType 1), power-law shear exponent 0.2",
+                      "note": "tower side-to-side free decay in operation (region 2), still water, from near the "
+                              "8 m/s operating state with 0.3 m of tower-top side-to-side"},
 }
 CHANNELS = ("PtfmSurge", "PtfmSway", "PtfmHeave", "PtfmRoll", "PtfmPitch", "PtfmYaw", "RotSpeed", "BldPitch1",
             "GenPwr", "GenTq", "RotThrust", "TwrBsMyt", "TwrBsMxt", "YawBrTAxp", "YawBrTAyp", "TTDspFA", "TTDspSS",

@@ -84,7 +84,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def run_and_package(argv: list[str] | None, doc: str, runs: dict, case_of: Callable[[str], dict],
-                    channels: tuple[str, ...], default_out: Path, created_by: str) -> int:
+                    channels: tuple[str, ...], default_out: Path, created_by: str,
+                    transform: Callable | None = None) -> int:
     """The command line of the OpenFAST run tools: build each of ``runs`` (``make_runs.build`` of the shared
     decks, in a working copy), run those without an ``.outb``, write their ``case.json`` (``case_of(name)``) and
     :func:`package` them."""
@@ -115,14 +116,16 @@ def run_and_package(argv: list[str] | None, doc: str, runs: dict, case_of: Calla
 
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         names = list(pool.map(one, runs))
-    package(work, names, args.out, channels, created_by)
+    package(work, names, args.out, channels, created_by, transform)
     return 0
 
 
-def package(work: Path, names: list[str], out: Path, channels: tuple[str, ...], created_by: str) -> None:
+def package(work: Path, names: list[str], out: Path, channels: tuple[str, ...], created_by: str,
+            transform: Callable | None = None) -> None:
     """Compact copies of the runs ``work/runs/<name>`` in ``out``: records at :data:`FS_OUT` of the ``channels``
     each run has (constant ones dropped), the case files with the ElastoDyn initial conditions (``start``) and
-    ``summary.json`` with the sha256 of every source and input."""
+    ``summary.json`` with the sha256 of every source and input. ``transform(record)``, if given, returns the
+    record to compact (e.g. with the rotor azimuth unwrapped, which the anti-alias filter would smear)."""
     sys.path.insert(0, str(REPO))
     sys.path.insert(0, str(REPO / "tools"))
     from compact_openfast_reference import compact, sha256
@@ -136,6 +139,8 @@ def package(work: Path, names: list[str], out: Path, channels: tuple[str, ...], 
         rd = work / "runs" / name
         outb = rd / f"{name}.outb"
         rec = load_record(outb, unknown_channels="keep")
+        if transform is not None:
+            rec = transform(rec)
         chans = [c for c in channels if c in rec and float(rec[c].std()) > 0.0]
         small = compact(rec, chans, FS_OUT, name, f"{name}/{outb.name}")
         small.save(out / f"{name}.npz")
