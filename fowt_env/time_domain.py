@@ -125,8 +125,8 @@ def time_domain(reference: str | Path | None = None, model: Any = None, *, runs:
         Folder of runs (``<run>.case.json`` beside a record that starts at the run's t = 0, e.g. an ``.outb``
         written with ``TStart = 0``); default the packaged runs (:func:`packaged_time_domain_dir`).
     model : surrogates.FOWTModel, optional
-        Default: the model with OpenFAST's gauge heights, ``rotor_1p`` off (the deck's rotor is balanced), as
-        :func:`fowt_env.validation.validate` uses.
+        Default: :func:`fowt_env.validation.reference_model` (OpenFAST's gauge heights, ``rotor_1p`` off: the
+        deck's rotor is balanced), as :func:`fowt_env.validation.validate` uses.
     runs : sequence of str, optional
         Names, prefixes or glob patterns of the runs; default all.
     channels : sequence of str
@@ -163,8 +163,9 @@ def time_domain(reference: str | Path | None = None, model: Any = None, *, runs:
     if not folder.is_dir():
         raise ValueError(f"{folder}: not a folder of time-domain runs")
     if model is None:
-        heights = getattr(surrogates, "OPENFAST_GAUGE_HEIGHTS", None)
-        model = surrogates.FOWTModel(gauge_heights=heights).with_effects(rotor_1p=0.0)
+        from .validation import reference_model
+
+        model = reference_model()
     scores: list[TimeDomainScore] = []
     records: dict[str, tuple[Any, Any]] = {}
     for name, path, case in _runs(folder, runs):

@@ -67,6 +67,7 @@ __all__ = [
     "packaged_reference_dir",
     "psd",
     "record_dels",
+    "reference_model",
     "record_statistics",
     "spread_tolerance",
     "surrogate_case",
@@ -1185,6 +1186,25 @@ def reference_statistics(run: ReferenceRun, channels: Iterable[str]) -> dict[str
 
 
 # ---------------------------------------------------------------------------------------------- surrogate
+def reference_model() -> Any:
+    """The surrogate the OpenFAST comparisons use by default (:func:`validate`,
+    :func:`fowt_env.time_domain.time_domain`, the OpenFAST decay tests).
+
+    All effects but ``rotor_1p`` (the OC3 Hywind deck's rotor is perfectly balanced and its blades identically
+    pitched: it has no 1P loads to compare with), the tower gauges at the shared OpenFAST runs' heights
+    (``surrogates.OPENFAST_GAUGE_HEIGHTS``, 11.94 ... 85.66 m above MSL).
+
+    Returns
+    -------
+    surrogates.FOWTModel
+    """
+    import surrogates
+
+    heights = getattr(surrogates, "OPENFAST_GAUGE_HEIGHTS", None)
+    model = surrogates.FOWTModel() if heights is None else surrogates.FOWTModel(gauge_heights=heights)
+    return model.with_effects(rotor_1p=0.0)
+
+
 def surrogate_case(case: Mapping[str, Any]) -> Any:
     """The surrogate's load case for a run's ``case.json`` (None for a free decay: parked, still water).
 
@@ -1556,10 +1576,8 @@ def validate(
         OpenFAST outputs of any readable format, each with a ``<run>.case.json`` sidecar
         (see :func:`load_reference`), e.g. ``shared/reference/openfast/runs``.
     model : surrogates.FOWTModel, optional
-        The surrogate; default ``surrogates.FOWTModel(gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS)`` with
-        ``rotor_1p`` off (all other effects; tower gauges at the shared OpenFAST runs' heights, 11.94 ... 85.66 m
-        above MSL; the OC3 Hywind deck's rotor is perfectly balanced and its blades identically pitched, so it
-        has no 1P loads to compare with).
+        The surrogate; default :func:`reference_model` (all effects but ``rotor_1p``, the tower gauges at the
+        shared OpenFAST runs' heights).
     seeds : int or sequence of int
         Number of seeds of the operating runs (``base_seed``, ``base_seed + 1``, ...) or the seeds themselves;
         default 8. The free decays are deterministic (no waves, no wind, no noise) and use one seed.
@@ -1632,10 +1650,8 @@ def validate(
     from .progress import progress_bar
 
     t_start = time.perf_counter()
-    if model is None:  # the gauges where the reference deck has them (TwrGagNd of the shared runs)
-        heights = getattr(surrogates, "OPENFAST_GAUGE_HEIGHTS", None)
-        model = surrogates.FOWTModel() if heights is None else surrogates.FOWTModel(gauge_heights=heights)
-        model = model.with_effects(rotor_1p=0.0)  # the reference deck's rotor is balanced: no 1P loads
+    if model is None:
+        model = reference_model()
     seed_list = _seed_list(seeds, base_seed)
     if wind not in WIND_SOURCES:
         raise ValueError(f"wind must be one of {', '.join(WIND_SOURCES)}, got {wind!r}")

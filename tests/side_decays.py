@@ -10,6 +10,7 @@ from typing import Any
 
 import surrogates
 from fowt_env.io import load_record
+from fowt_env.validation import reference_model
 
 DATA = resources.files("fowt_env") / "data" / "openfast_side_decays"
 
@@ -21,5 +22,6 @@ def decay_run(name: str) -> tuple[Any, dict]:
 
 
 def decay_model() -> surrogates.FOWTModel:
-    """``validate()``'s default model: the deck's gauges, no 1P loads (the deck's rotor is balanced)."""
-    return surrogates.FOWTModel(gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS).with_effects(rotor_1p=0.0)
+    """``validate()``'s default model (:func:`fowt_env.validation.reference_model`): the deck's gauges, no 1P
+    loads (the deck's rotor is balanced)."""
+    return reference_model()

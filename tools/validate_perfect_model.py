@@ -38,12 +38,7 @@ from pathlib import Path
 import numpy as np
 
 import surrogates
-from fowt_env.validation import packaged_reference_dir, surrogate_case, validate
-
-
-def _model() -> surrogates.FOWTModel:
-    """``validate()``'s default model."""
-    return surrogates.FOWTModel(gauge_heights=surrogates.OPENFAST_GAUGE_HEIGHTS).with_effects(rotor_1p=0.0)
+from fowt_env.validation import packaged_reference_dir, reference_model, surrogate_case, validate
 
 
 def _seeds(text: str) -> list[int]:
@@ -87,7 +82,8 @@ def build_truth(reference: Path, folder: Path, seed: int, inflow: bool = False) 
             field = folder / f"{name}.inflow.npz"
             write_inflow(field, lc, duration + transient + 20.0, seed)
             extra["wind"] = MeasuredWind.from_inflow(field)
-        rec = surrogates.simulate(_model(), lc, duration, 0.0125, seed, transient=transient, noise=False, **extra)
+        rec = surrogates.simulate(reference_model(), lc, duration, 0.0125, seed, transient=transient, noise=False,
+                                  **extra)
         rec.save(folder / f"{name}.npz")
         (folder / f"{name}.case.json").write_text(json.dumps(case, indent=1))
         names.append(name)
