@@ -204,7 +204,7 @@ HARMONICS_SHEAR_EXPONENT = 0.2
 
 @functools.lru_cache(maxsize=1)
 def side_force_law() -> float:
-    """The rotor's 3P side force per unit of ``V^2 dQ/dV`` (1/(m s), i.e. N per (m/s)^2 N m s/m), for
+    """The rotor's 3P side force per unit of ``V^2 dQ/dV`` (s/m^2: N of force per N m^2/s of ``V^2 dQ/dV``), for
     :attr:`surrogates.model.RotorHarmonics.side_force_3p` = 1.
 
     The side force's amplitude is ``side_force_3p * T_12 * (V^2 dQ/dV) / (V_12^2 dQ/dV_12)``: the harmonic's
@@ -401,7 +401,7 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
         u[nl0 + 4] += mzg * s_th * ctrl[I_ACC]
     # --- nonlinear rotor: Ct/Cq surfaces at the wind relative to the moving hub, DISCON's torque and pitch
     domega = 0.0
-    side_drive = harm[15]  # V^2 dQ/dV of the 3P side force (m^2/s^2 N m s/m): the operating point's, or below
+    side_drive = harm[15]  # V^2 dQ/dV of the 3P side force (N m^2/s): the operating point's, or below
     if par[P_ROTOR] > 0.0:
         v_hub = 0.0
         theta = 0.0
