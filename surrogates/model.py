@@ -107,8 +107,9 @@ class RotorHarmonics:
     force, which follows ``V^2 dQ/dV`` at every step (:func:`surrogates.simulate.side_force_law`): OpenFAST's
     side-to-side 3P response in steady wind at 8-18 m/s rises above rated while the thrust falls. The side
     force's 3.7 kN is the 3P amplitude of OpenFAST's tower-top shear force ``YawBrFyp``, a response rather than
-    the rotor's own lateral force (the shaft's ``LSShftFya``: 0.66 kN): an effective side-to-side 3P excitation,
-    whose tower-base response is 0.7-1.2x OpenFAST's at 8-18 m/s (``tests/test_rotor_harmonics.py``). The 1P terms
+    the rotor's own lateral force (the shaft's ``LSShftFya``/``LSShftFza`` turned into the fixed frame with the
+    azimuth: 1.4 kN at 3P, 2.1 kN at 18 m/s): an effective side-to-side 3P excitation, whose tower-base response is
+    0.64-1.17x OpenFAST's at 8-18 m/s (``tests/test_rotor_harmonics.py``). The 1P terms
     are engineering estimates, not in the OpenFAST deck (its rotor is perfectly balanced): a balancing grade of
     the order of ISO G16 and a small pitch misalignment. Each effect's strength scales them.
 

@@ -215,7 +215,14 @@ def side_force_law() -> float:
     deficit, a fixed fraction of the wind; OpenFAST's side-to-side 3P response in steady wind with shear 0.2 at
     8, 10, 12, 14 and 18 m/s (``tools/openfast_rotor_harmonics_runs.py``) rises as ``V^2 dQ/dV`` does
     (x8 from 8 to 18 m/s) while the thrust falls above rated: the tower's 3P side-to-side response scaled with the
-    thrust was 2x OpenFAST's at 8 m/s and 0.1x at 18 m/s.
+    thrust was 2x OpenFAST's at 8 m/s and 0.1x at 18 m/s. With the linear rotor the 12 m/s side force is exactly
+    ``side_force_3p * T_12``; the nonlinear rotor's ``dQ/dV`` (+-1 m/s differences of the rotor-normal wind, the
+    blades bent) is within 1-2 % of the operating point's there.
+
+    Returns
+    -------
+    float
+        ``T_12 / (V_12^2 dQ/dV_12)`` (s/m^2), with ``V_12`` = :data:`HARMONICS_WIND_SPEED`.
     """
     op = operating_point(HARMONICS_WIND_SPEED)
     return float(op.thrust / (HARMONICS_WIND_SPEED**2 * op.dQ_dV))

@@ -3,8 +3,8 @@
 The runs are ``tools/openfast_rotor_harmonics_runs.py``'s (OpenFAST v5.0.0 on the shared OC3 deck, steady wind
 with the deck's shear exponent 0.2, still water, 160 s from near the steady state), packaged in
 ``fowt_env/data/openfast_rotor_harmonics/`` with the rotor azimuth unwrapped. Both models' lines are demodulated
-against their own azimuth over the last 60 s (OpenFAST's ``Azimuth``; the surrogate's from its rotor speed,
-started at OpenFAST's initial azimuth).
+against their own azimuth over the last 60 s (OpenFAST's ``Azimuth``; the surrogate's integrated from its rotor
+speed, started at 0: the amplitudes do not depend on the phase).
 """
 
 from __future__ import annotations

@@ -23,9 +23,9 @@ What
 Why
     The rotor's 3P loads on the tower (the blades passing the tower's shadow and sampling the shear) depend on the
     operating point, and the only steady-wind run of the shared reference is at 12 m/s. OpenFAST's side-to-side
-    3P response of the tower base (``TwrBsMxt``) is 185, 452, 342, 388 and 632 kN m at 8, 10, 12 (the shared run,
-    with waves), 14 and 18 m/s: it rises above rated, where the thrust falls and the torque's sensitivity to the
-    wind grows with the blade pitch. :func:`surrogates.simulate.side_force_law` and
+    3P response of the tower base (``TwrBsMxt``, demodulated over the last 60 s of the compact records) is 198, 453,
+    345, 378 and 646 kN m at 8, 10, 12, 14 and 18 m/s: it rises above rated, where the thrust falls and the
+    torque's sensitivity to the wind grows with the blade pitch. :func:`surrogates.simulate.side_force_law` and
     ``tests/test_rotor_harmonics.py`` rest on these runs.
 
 Usage (maintainer tool, not run by the tests; OpenFAST ~3.5 min per run on one core, two in parallel)::
@@ -41,8 +41,12 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from surrogates.record import Record
 
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_OUT = REPO / "fowt_env" / "data" / "openfast_rotor_harmonics"
@@ -64,8 +68,19 @@ CHANNELS = ("Azimuth", "RotSpeed", "BldPitch1", "GenPwr", "RotThrust", "LSShftTq
 """Channels of the compact records (those the run has, constant ones dropped)."""
 
 
-def unwrap_azimuth(record):
-    """The record with its ``Azimuth`` (deg) unwrapped, so that decimation keeps it."""
+def unwrap_azimuth(record: Record) -> Record:
+    """The record with its ``Azimuth`` (deg) unwrapped, so that decimation keeps it.
+
+    Parameters
+    ----------
+    record : surrogates.Record
+        An OpenFAST output with the channel ``Azimuth`` (deg, wrapped to 0-360).
+
+    Returns
+    -------
+    surrogates.Record
+        The same record, ``Azimuth`` made monotonic (deg).
+    """
     y = np.array(record.y, dtype=float)
     i = record.channels.index("Azimuth")
     y[:, i] = np.degrees(np.unwrap(np.radians(y[:, i])))

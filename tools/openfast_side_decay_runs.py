@@ -34,7 +34,7 @@ Why
     sway, yaw at 0.1-0.15 Hz) sits on that mode. The roll decays give the roll mode (29.9 s parked, 29.5 s in
     operation) and how much the pitched platform yaws as it rolls. The tower's side-to-side decays give its first
     side-to-side mode parked (0.457 Hz, the rotor locked to the nacelle) and in operation, where the rotor turns
-    free of the nacelle's roll (0.497 Hz at 8 and at 12 m/s, damping 1.0 %): on it sits the 3P resonance of a
+    free of the nacelle's roll (0.497-0.498 Hz at 8 and at 12 m/s, damping 1.0 %): on it sits the 3P resonance of a
     turbulent 12 m/s run whose rotor drops into region 2 (``tests/test_tower_side_decay.py``).
     ``tests/test_yaw_decay.py`` and ``tests/test_roll_decay.py`` hold the surrogate to the platform's decays.
 

@@ -45,6 +45,10 @@ import sys
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from surrogates.record import Record
 
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_SHARED = REPO.parent / "shared"
@@ -85,10 +89,10 @@ def main(argv: list[str] | None = None) -> int:
 
 def run_and_package(argv: list[str] | None, doc: str, runs: dict, case_of: Callable[[str], dict],
                     channels: tuple[str, ...], default_out: Path, created_by: str,
-                    transform: Callable | None = None) -> int:
+                    transform: Callable[[Record], Record] | None = None) -> int:
     """The command line of the OpenFAST run tools: build each of ``runs`` (``make_runs.build`` of the shared
     decks, in a working copy), run those without an ``.outb``, write their ``case.json`` (``case_of(name)``) and
-    :func:`package` them."""
+    :func:`package` them, each record passed through ``transform`` first if given."""
     ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--openfast-build", required=True, type=Path, help="cmake build tree (openfast)")
     ap.add_argument("--work", required=True, type=Path, help="working copy of the shared decks and the runs")
@@ -121,7 +125,7 @@ def run_and_package(argv: list[str] | None, doc: str, runs: dict, case_of: Calla
 
 
 def package(work: Path, names: list[str], out: Path, channels: tuple[str, ...], created_by: str,
-            transform: Callable | None = None) -> None:
+            transform: Callable[[Record], Record] | None = None) -> None:
     """Compact copies of the runs ``work/runs/<name>`` in ``out``: records at :data:`FS_OUT` of the ``channels``
     each run has (constant ones dropped), the case files with the ElastoDyn initial conditions (``start``) and
     ``summary.json`` with the sha256 of every source and input. ``transform(record)``, if given, returns the
