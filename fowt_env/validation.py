@@ -62,6 +62,7 @@ __all__ = [
     "decay_analysis",
     "elastodyn_initial_conditions",
     "fit_damped_oscillation",
+    "harmonic_amplitude",
     "load_reference",
     "mean_tolerance",
     "packaged_reference_dir",
@@ -374,6 +375,66 @@ def _crossings(t: NDArray[np.float64], y: NDArray[np.float64], min_gap: float) -
             continue
         out.append(float(tc))
     return np.asarray(out)
+
+
+def harmonic_amplitude(t: ArrayLike, azimuth_deg: ArrayLike, x: ArrayLike, *, order: int = 3,
+                       window_s: float | None = None) -> float:
+    """Amplitude of the ``order``-per-revolution line of ``x``, demodulated against the rotor azimuth.
+
+    A least-squares fit of ``a cos(n psi) + b sin(n psi) + c + d t`` (the constant and the trend take the slow
+    motion) over the last ``window_s`` seconds; the amplitude is ``hypot(a, b)``, independent of where the azimuth
+    starts. The 3P line of a tower load in steady wind is its tower-shadow and shear response.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+        Time (s).
+    azimuth_deg : array_like, shape (n,)
+        Rotor azimuth (deg), OpenFAST's ``Azimuth`` (wrapped or not) or a surrogate's integrated rotor speed.
+    x : array_like, shape (n,)
+        The channel (any unit; the amplitude has its unit).
+    order : int
+        Harmonic of the rotor speed, >= 1; default 3 (blade passing).
+    window_s : float, optional
+        Length (s) of the analysed end of the record; default the whole record.
+
+    Returns
+    -------
+    float
+        The line's amplitude.
+
+    Raises
+    ------
+    ValueError
+        For arrays of different lengths, non-finite samples, ``order < 1`` or a window holding fewer than 4 samples.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0.0, 60.0, 0.05)
+    >>> az = 72.0 * t  # 12 rpm
+    >>> x = 5.0 + 2.0 * np.cos(np.radians(3 * az) + 0.4) + np.sin(0.3 * t)
+    >>> round(harmonic_amplitude(t, az, x), 2)
+    2.0
+    """
+    t_arr = _as_signal(t, "t")
+    az = _as_signal(azimuth_deg, "azimuth_deg")
+    x_arr = _as_signal(x, "x")
+    if not (t_arr.shape == az.shape == x_arr.shape):
+        raise ValueError(f"t, azimuth_deg and x must have the same shape, got {t_arr.shape}, {az.shape}, "
+                         f"{x_arr.shape}")
+    if not (np.all(np.isfinite(t_arr)) and np.all(np.isfinite(az)) and np.all(np.isfinite(x_arr))):
+        raise ValueError("t, azimuth_deg and x must be finite")
+    if int(order) != order or order < 1:
+        raise ValueError(f"order must be an integer >= 1, got {order!r}")
+    m = np.ones(t_arr.shape, dtype=bool) if window_s is None else t_arr > t_arr[-1] - float(window_s)
+    if np.count_nonzero(m) < 4:
+        raise ValueError(f"the window of {window_s!r} s holds fewer than 4 samples")
+    psi = np.radians(az[m]) * int(order)
+    tt = t_arr[m] - t_arr[m].mean()
+    basis = np.column_stack([np.cos(psi), np.sin(psi), np.ones_like(tt), tt])
+    coef, *_ = np.linalg.lstsq(basis, x_arr[m], rcond=None)
+    return float(math.hypot(coef[0], coef[1]))
 
 
 def fit_damped_oscillation(t: ArrayLike, x: ArrayLike, *, span_s: float = 25.0,
