@@ -57,6 +57,7 @@ __all__ = [
     "DecayResult",
     "ReferenceRun",
     "ValidationReport",
+    "azimuth_from_rotor_speed",
     "band_std",
     "damage_equivalent_load",
     "decay_analysis",
@@ -375,6 +376,39 @@ def _crossings(t: NDArray[np.float64], y: NDArray[np.float64], min_gap: float) -
             continue
         out.append(float(tc))
     return np.asarray(out)
+
+
+def azimuth_from_rotor_speed(t: ArrayLike, rotor_speed_rpm: ArrayLike, start_deg: float = 0.0) -> NDArray[np.float64]:
+    """The rotor azimuth (deg, unwrapped) integrated from a rotor-speed channel by the trapezoidal rule.
+
+    For a record without ``Azimuth`` (the surrogate's): :func:`harmonic_amplitude` needs only the azimuth's
+    increments, so ``start_deg`` matters only for the phase.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+        Time (s).
+    rotor_speed_rpm : array_like, shape (n,)
+        Rotor speed (rpm), e.g. ``RotSpeed``.
+    start_deg : float
+        Azimuth at ``t[0]`` (deg).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Azimuth (deg).
+
+    Examples
+    --------
+    >>> azimuth_from_rotor_speed([0.0, 1.0, 2.0], [12.0, 12.0, 12.0]).tolist()
+    [0.0, 72.0, 144.0]
+    """
+    t_arr = np.asarray(t, dtype=np.float64)
+    omega = np.asarray(rotor_speed_rpm, dtype=np.float64) * 6.0  # deg/s
+    if t_arr.ndim != 1 or t_arr.shape != omega.shape:
+        raise ValueError(f"t and rotor_speed_rpm must be 1-D of one length, got {t_arr.shape} and {omega.shape}")
+    steps = 0.5 * (omega[1:] + omega[:-1]) * np.diff(t_arr)
+    return float(start_deg) + np.concatenate([[0.0], np.cumsum(steps)])
 
 
 def harmonic_amplitude(t: ArrayLike, azimuth_deg: ArrayLike, x: ArrayLike, *, order: int = 3,

@@ -19,7 +19,7 @@ from side_decays import decay_model  # tests/ is on sys.path (pytest prepend mod
 
 import surrogates
 from fowt_env.io import load_record
-from fowt_env.validation import harmonic_amplitude
+from fowt_env.validation import azimuth_from_rotor_speed, harmonic_amplitude
 
 DATA = resources.files("fowt_env") / "data" / "openfast_rotor_harmonics"
 SPEEDS = (8, 10, 12, 14, 18)
@@ -43,8 +43,7 @@ def _surrogate(speed: int) -> dict[str, float]:
     sim = surrogates.simulate(decay_model(), lc, float(case["duration_s"]), 0.0125, 0, transient=0.0, noise=False,
                               initial={**case["start"], "Azimuth": 0.0})
     t = np.asarray(sim.t)
-    omega = np.radians(np.asarray(sim["RotSpeed"]) * 6.0)  # rpm -> rad/s
-    azimuth = np.degrees(np.concatenate([[0.0], np.cumsum(0.5 * (omega[1:] + omega[:-1]) * np.diff(t))]))
+    azimuth = azimuth_from_rotor_speed(t, sim["RotSpeed"])
     return {ch: _amplitude(t, azimuth, np.asarray(sim[ch])) for ch in ("TwrBsMxt", "RotThrust")}
 
 

@@ -26,7 +26,7 @@ from scipy.signal import butter, sosfiltfilt
 
 import surrogates
 from fowt_env.io import load_record
-from fowt_env.validation import harmonic_amplitude, reference_model
+from fowt_env.validation import azimuth_from_rotor_speed, harmonic_amplitude, reference_model
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = resources.files("fowt_env") / "data"
@@ -50,10 +50,8 @@ def lines() -> tuple[list[float], list[float]]:
         case = json.loads((folder / f"h_st{u:02d}.case.json").read_text())
         of.append(harmonic_amplitude(rec.t, rec["Azimuth"], rec["TwrBsMxt"], window_s=WINDOW_S))
         sim = _surrogate(case, float(case["duration_s"]), {**case["start"], "Azimuth": 0.0})
-        t = np.asarray(sim.t)
-        omega = np.radians(np.asarray(sim["RotSpeed"]) * 6.0)
-        azimuth = np.degrees(np.concatenate([[0.0], np.cumsum(0.5 * (omega[1:] + omega[:-1]) * np.diff(t))]))
-        sur.append(harmonic_amplitude(t, azimuth, sim["TwrBsMxt"], window_s=WINDOW_S))
+        azimuth = azimuth_from_rotor_speed(sim.t, sim["RotSpeed"])
+        sur.append(harmonic_amplitude(sim.t, azimuth, sim["TwrBsMxt"], window_s=WINDOW_S))
     return of, sur
 
 
