@@ -571,7 +571,9 @@ class FOWTModel:
         # the rotor's aerodynamic damping of tilt and yaw: a disc turning at (pitch rate, yaw rate) meets the
         # relative-wind gradients dU/dy = +yaw rate, dU/dz = -pitch rate, loaded as any disc gradient (the
         # simulation's nonlinear rotor does the same blade by blade)
-        rate_rows = (r_tt[2], -r_tt[1])
+        # (the blades answer them DISC_RATE_LAG_DEG of azimuth late: the gradient turns by that angle in the disc)
+        c_lag, s_lag = math.cos(DISC_RATE_LAG), math.sin(DISC_RATE_LAG)
+        rate_rows = (c_lag * r_tt[2] + s_lag * r_tt[1], -c_lag * r_tt[1] + s_lag * r_tt[2])
         motion_loads = _shear_hub_loads(op, st.data.tip_radius, 0.0 if nonlinear_rotor else s_aero)
         for rows, (force, moment) in zip(rate_rows, motion_loads, strict=True):
             f_x[:, N_DOF:2 * N_DOF] += np.outer(j_hub.T @ force + r_tt.T @ moment, rows)
@@ -584,8 +586,8 @@ class FOWTModel:
             g_b = s_aero * op.dT_dV / 3.0
             r_t, r_ty = blade_load_radii(st.data.tip_radius)
             it, iy = _CYCLIC
-            cyc_x[it, N_DOF:2 * N_DOF] += -s_aero * cyc_gain[0] * r_tt[1]
-            cyc_x[iy, N_DOF:2 * N_DOF] += -s_aero * cyc_gain[1] * r_tt[2]
+            cyc_x[it, N_DOF:2 * N_DOF] += s_aero * cyc_gain[0] * rate_rows[1]
+            cyc_x[iy, N_DOF:2 * N_DOF] += -s_aero * cyc_gain[1] * rate_rows[0]
             p_t = flap.thrust_shape
             vel_t = np.zeros(n_x)  # rotating-frame flap velocity projected on cos psi_b (tilt), then sin (yaw)
             vel_y = np.zeros(n_x)
@@ -908,6 +910,27 @@ TOWER_AERO = {"cd": 1.0, "diameter_base": 6.5, "diameter_top": 3.87, "shear_expo
 3.87 m at the top) under the power-law mean profile (exponent 0.2, TurbSim's IEC default), scaled by the
 instantaneous hub-height wind."""
 
+
+DISC_RATE_LAG_DEG = 6.0
+"""Azimuth (deg) by which the blades' aerodynamic loads lag the relative-wind gradient of the disc's own tilt and
+yaw rates (``aero_damping``): the blades answer the rates' gradient turned by this angle in the disc, so a share
+``sin`` of the rotor's tilt damping becomes a yaw moment against the gyroscopic one (and of its yaw damping a tilt
+moment), beyond what the blades' cyclic flap modes turn (:func:`cyclic_flap_lag`). Calibrated, not derived.
+
+OpenFAST with the platform's yaw held (``tools/openfast_yaw_locked_runs.py``, steady 12 m/s, Hs 2.5 m, Tp 10 s)
+gives the yaw moment that the pitching platform puts on the rotor. Per unit platform pitch rate over 0.08-0.14 Hz it
+is 17-22 MN m s in phase and 14 in quadrature; the surrogate gave 29-33 and 13-23, which made its steady-wind yaw
+1.3x OpenFAST's in the wave band. The gyroscopic part is not the difference: without aerodynamics both give
+48.6 / 47.7 MN m s per unit pitch rate and 1.19 / 1.17 MN m per m/s of the tower top's deflection rate. The
+difference is aerodynamic, and OpenFAST's rigid rotor already carries most of it: with its blades' flap DOFs off,
+its aerodynamics take the held yaw moment from the gyroscopic 60-85 MN m s in phase (rising with frequency as the
+tower top's rotation does) to 25-45, the surrogate's rigid rotor only to 61-80. Neither
+unsteady aerodynamics (``UA_Mod = 0``), the skewed-wake model (``Skew_Mod = 0``) nor the edge DOF carries it (each
+switched off: within 1-7 MN m s), and it is no quasi-static sensitivity (held fixed at 12.1 rpm and 0 deg blade pitch,
+the yaw moment changes by 6 kN m per m/s of wind and -0.4 MN m per rad of platform pitch). A lag of 6 deg
+gives 21-23 / 10-18 MN m s (``tests/test_yaw_locked.py``) and the steady-wind yaw 0.99x OpenFAST's in the wave band;
+its cause in AeroDyn is open."""
+DISC_RATE_LAG = math.radians(DISC_RATE_LAG_DEG)
 
 BLADE_SAMPLING_RADIUS = 0.75
 """Radius of the blade-effective wind (fraction of R): the field averaged along the blade with weights

@@ -45,6 +45,7 @@ from .drag import N_STRIPS, drag_strips
 from .load_cases import LoadCase
 from .model import (
     BLADE_SAMPLING_RADIUS,
+    DISC_RATE_LAG,
     INPUT_BLOCKS,
     N_INPUT,
     N_STATE,
@@ -158,8 +159,8 @@ def _blade_wind_columns(wind: RotorWind, wind_speed: float) -> np.ndarray:
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
     P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP, P_PHIT, P_VT, P_WT, \
     P_VY, P_WY, P_FIP, P_SPINC, P_SSKEW, P_SKT, P_SKM, P_SKF, P_SBEND, P_DBEND, P_SCURV, P_INCF0, \
-    P_INCF1 = range(41)
-N_PAR = 41
+    P_INCF1, P_LAGC, P_LAGS = range(43)
+N_PAR = 43
 """(P_PHIT: the blade's flap mode at the thrust's centre, ``BladeFlapMode.thrust_shape``; P_VT, P_WT, P_VY, P_WY:
 :func:`surrogates.model.cyclic_flap_aero_shares`; P_FIP: the in-plane force's share of a blade's tip flap velocity,
 its gain-weighted mean of the flap shape; P_SPINC: ``c / J`` of :func:`surrogates.model.rotor_free_inertia`, how the
@@ -168,7 +169,8 @@ rotor speed relative to the nacelle answers the nacelle's roll about the shaft; 
 :func:`surrogates.aero.skew_gains` at the equilibrium's inclination; P_SBEND, P_DBEND: strength of
 ``blade_deflection`` and the tip deflection (m) of :func:`surrogates.aero.blade_deflection_table`'s bent blades;
 P_SCURV: strength of ``sampled_wind_curvature``; P_INCF0, P_INCF1: the in-plane force's share of the rotor's
-in-plane wind, straight blades and per metre of tip deflection, :func:`surrogates.aero.inclined_rotor_inplane`.)"""
+in-plane wind, straight blades and per metre of tip deflection, :func:`surrogates.aero.inclined_rotor_inplane`;
+P_LAGC, P_LAGS: cosine and sine of :data:`surrogates.model.DISC_RATE_LAG_DEG`.)"""
 I_ACC = N_CONTROLLER_STATE
 """Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
 accelerations of the previous internal step (m/s^2, rad/s^2), which the CM kinematics (``cm_kinematics``) read."""
@@ -523,8 +525,10 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 psi_b = psi + b * 2.0 * math.pi / 3.0
                 c_b = math.cos(psi_b)
                 s_b = math.sin(psi_b)
-                # blade at r_s (-sin, cos)
-                dv_r = -s_rot * (rate_y * par[P_RS] * c_b + rate_z * par[P_RS] * s_b)
+                # blade at r_s (-sin, cos); it answers the disc's rates DISC_RATE_LAG_DEG of azimuth late
+                c_l = c_b * par[P_LAGC] + s_b * par[P_LAGS]
+                s_l = s_b * par[P_LAGC] - c_b * par[P_LAGS]
+                dv_r = -s_rot * (rate_y * par[P_RS] * c_l + rate_z * par[P_RS] * s_l)
                 dv = dv_r - s_rot * (flap_t * c_b + flap_y * s_b)
                 # the in-plane force meets the rates at its own mean radius and the flap at its own mean shape
                 dv_r = dv_r * par[P_RIP] - s_rot * par[P_FIP] * (tip_t * c_b + tip_y * s_b)
@@ -917,6 +921,7 @@ class Simulator:
             par[P_SSKEW] = float(eff["rotor_skew"])
             par[P_SCURV] = float(eff["sampled_wind_curvature"])
             par[P_INCF0], par[P_INCF1] = inclined_rotor_inplane(self.case.wind_speed)
+            par[P_LAGC], par[P_LAGS] = math.cos(DISC_RATE_LAG), math.sin(DISC_RATE_LAG)
         if op is not None and self.nonlinear_rotor:
             par[P_SBEND] = float(eff["blade_deflection"])
             par[P_DBEND] = bent.tip_deflection
