@@ -43,8 +43,9 @@ EFFECTS: dict[str, Effect] = {
         Effect("mooring_nonlinear", "Offset-dependent catenary restoring of the three OC3 lines (hardening with "
                "surge/sway offset, set-down), beyond the linear tangent stiffness.", linear=False),
         Effect("aero_damping", "Thrust and rotor torque respond to the wind relative to the moving hub (dT/dV times "
-               "the hub's fore-aft velocity), and the disc's tilt and yaw rates load it like wind gradients: "
-               "aerodynamic damping of platform pitch and yaw and of the tower's bending.", linear=True),
+               "the hub's fore-aft velocity), and the disc's tilt and yaw rates load it like wind gradients, answered "
+               "DISC_RATE_LAG_DEG of azimuth late: aerodynamic damping of platform pitch and yaw and of the tower's "
+               "bending, and a yaw moment against the gyroscopic one.", linear=True),
         Effect("gyroscopic", "Angular momentum of the spinning rotor couples tower-top pitch and yaw rates "
                "(moment H x omega).", linear=True),
         Effect("rotor_3p", "Blade passing: tower shadow and wind shear modulate thrust, torque and rotor moments "

@@ -918,18 +918,17 @@ yaw rates (``aero_damping``): the blades answer the rates' gradient turned by th
 moment), beyond what the blades' cyclic flap modes turn (:func:`cyclic_flap_lag`). Calibrated, not derived.
 
 OpenFAST with the platform's yaw held (``tools/openfast_yaw_locked_runs.py``, steady 12 m/s, Hs 2.5 m, Tp 10 s)
-gives the yaw moment that the pitching platform puts on the rotor. Per unit platform pitch rate over 0.08-0.14 Hz it
-is 17-22 MN m s in phase and 14 in quadrature; the surrogate gave 29-33 and 13-23, which made its steady-wind yaw
-1.3x OpenFAST's in the wave band. The gyroscopic part is not the difference: without aerodynamics both give
-48.6 / 47.7 MN m s per unit pitch rate and 1.19 / 1.17 MN m per m/s of the tower top's deflection rate. The
-difference is aerodynamic, and OpenFAST's rigid rotor already carries most of it: with its blades' flap DOFs off,
-its aerodynamics take the held yaw moment from the gyroscopic 60-85 MN m s in phase (rising with frequency as the
-tower top's rotation does) to 25-45, the surrogate's rigid rotor only to 61-80. Neither
-unsteady aerodynamics (``UA_Mod = 0``), the skewed-wake model (``Skew_Mod = 0``) nor the edge DOF carries it (each
-switched off: within 1-7 MN m s), and it is no quasi-static sensitivity (held fixed at 12.1 rpm and 0 deg blade pitch,
-the yaw moment changes by 6 kN m per m/s of wind and -0.4 MN m per rad of platform pitch). A lag of 6 deg
-gives 21-23 / 10-18 MN m s (``tests/test_yaw_locked.py``) and the steady-wind yaw 0.99x OpenFAST's in the wave band;
-its cause in AeroDyn is open."""
+gives the yaw moment that the pitching platform puts on the rotor: per unit platform pitch rate, averaged over
+0.08-0.14 Hz, 19.6 MN m s in phase and -13.7 in quadrature; the surrogate gave 28.0 / -16.0, which made its
+steady-wind yaw 1.3x OpenFAST's in the wave band. The gyroscopic part is not the difference: without aerodynamics
+both give 48.5 / 47.1 MN m s per unit pitch rate and 1.20 / 1.15 MN m per m/s of the tower top's deflection rate.
+The difference is aerodynamic, and OpenFAST's rigid rotor already carries most of it: with its blades' flap DOFs
+off, its aerodynamics take the held yaw moment from the gyroscopic 74 MN m s in phase to 34.8, the surrogate's
+rigid rotor only to 63.5. Neither unsteady aerodynamics (``UA_Mod = 0``), the skewed-wake model (``Skew_Mod = 0``)
+nor the edge DOF carries it (each switched off in turn), and it is no quasi-static sensitivity (with the platform,
+the rotor speed and the blade pitch held, the yaw moment changes by 6 kN m per m/s of wind and by -0.4 MN m per rad
+of platform pitch). A lag of 6 deg gives 20.1 / -12.9 (``tests/test_yaw_locked.py``; rigid 53.2) and the
+steady-wind yaw 0.99x OpenFAST's in the wave band; its cause in AeroDyn is open."""
 DISC_RATE_LAG = math.radians(DISC_RATE_LAG_DEG)
 
 BLADE_SAMPLING_RADIUS = 0.75
