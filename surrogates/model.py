@@ -922,15 +922,15 @@ gives the yaw moment that the pitching platform puts on the rotor: per unit plat
 0.08-0.14 Hz, 19.6 MN m s in phase and -13.7 in quadrature; the surrogate gave 31.9 / -18.2, which made its
 steady-wind yaw 1.3x OpenFAST's in the wave band. The gyroscopic part is not the difference: without aerodynamics
 both give 48.5 / 48.1 MN m s per unit pitch rate and 1.20 / 1.17 MN m per m/s of the tower top's deflection rate.
-The difference is aerodynamic, and OpenFAST's rigid rotor already carries most of it: with its blades' flap DOFs
-off the held moment is 34.8 / -24.1, the surrogate's 69.2 / -15.9. Neither unsteady aerodynamics
-(``UA_Mod = 0``), the skewed-wake model (``Skew_Mod = 0``) nor the edge DOF carries it (each switched off in turn),
-and it is no quasi-static sensitivity (with the platform, the rotor speed and the blade pitch held, the yaw moment
-changes by 6 kN m per m/s of wind and by -0.4 MN m per rad of platform pitch). The lag is fitted to the operating
-held moment: 8 deg gives 19.9 / -13.6 (``tests/test_yaw_locked.py``; 6 deg 22.9 / -14.7, 10 deg about 16), and the
-steady-wind yaw 0.89x OpenFAST's in the wave band (its yaw damping, 0.215 against 0.185, is what is left too high).
-It leaves the rigid rotor's moment 1.6x OpenFAST's (54.3): it stands in for a mechanism it does not reproduce,
-whose cause in AeroDyn is open."""
+The difference is aerodynamic, and OpenFAST's rigid rotor already carries most of it: with its blades' flap DOFs off
+(runs made by hand, like those below, not shipped) the held moment is 34.8 / -24.1, the surrogate's 69.2 / -15.9.
+Neither unsteady aerodynamics (``UA_Mod = 0``), the skewed-wake model (``Skew_Mod = 0``) nor the edge DOF carries it
+(each switched off in turn), and it is no quasi-static sensitivity (with the platform, the rotor speed and the blade
+pitch held, the yaw moment changes by 6 kN m per m/s of wind and by -0.4 MN m per rad of platform pitch). The lag is
+fitted to the operating held moment: 8 deg gives 19.9 / -13.6 (``tests/test_yaw_locked.py``; 6 deg 22.9 / -14.7, 10
+deg about 16), and the steady-wind yaw 0.89x OpenFAST's in the wave band (its yaw damping, 0.215 against 0.185, is
+what is left too high). It leaves the rigid rotor's moment 1.6x OpenFAST's (54.3): it stands in for a mechanism it
+does not reproduce, whose cause in AeroDyn is open."""
 DISC_RATE_LAG = math.radians(DISC_RATE_LAG_DEG)
 
 BLADE_SAMPLING_RADIUS = 0.75
