@@ -514,6 +514,9 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
             tip_t = x[nd + it] + omega * x[iy]
             tip_y = x[nd + iy] - omega * x[it]
             flap_t = par[P_PHIT] * par[P_VT] * tip_t
+            # the blades answer the disc's rates DISC_RATE_LAG_DEG of azimuth late: the rates' gradient turned by it
+            lag_y = rate_y * par[P_LAGC] - rate_z * par[P_LAGS]
+            lag_z = rate_y * par[P_LAGS] + rate_z * par[P_LAGC]
             flap_y = par[P_PHIT] * par[P_VY] * tip_y
             mt = 0.0  # tilt and yaw moments of the blades' thrust
             my = 0.0
@@ -525,10 +528,8 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 psi_b = psi + b * 2.0 * math.pi / 3.0
                 c_b = math.cos(psi_b)
                 s_b = math.sin(psi_b)
-                # blade at r_s (-sin, cos); it answers the disc's rates DISC_RATE_LAG_DEG of azimuth late
-                c_l = c_b * par[P_LAGC] + s_b * par[P_LAGS]
-                s_l = s_b * par[P_LAGC] - c_b * par[P_LAGS]
-                dv_r = -s_rot * (rate_y * par[P_RS] * c_l + rate_z * par[P_RS] * s_l)
+                # blade at r_s (-sin, cos)
+                dv_r = -s_rot * (lag_y * par[P_RS] * c_b + lag_z * par[P_RS] * s_b)
                 dv = dv_r - s_rot * (flap_t * c_b + flap_y * s_b)
                 # the in-plane force meets the rates at its own mean radius and the flap at its own mean shape
                 dv_r = dv_r * par[P_RIP] - s_rot * par[P_FIP] * (tip_t * c_b + tip_y * s_b)
