@@ -47,7 +47,7 @@ from .validation import check_number
 
 __all__ = ["ROTOR_TABLES", "RotorTable", "rotor_table", "OperatingPoint", "operating_point", "RATED",
            "blade_inplane_sensitivity", "blade_inplane_gain", "inplane_ring_weights", "BladeSkewTable",
-           "blade_skew_table", "skew_gains", "inclined_rotor_moment",
+           "blade_skew_table", "skew_gains", "inclined_rotor_moment", "inclined_rotor_moment_by_pitch",
            "BladeDeflectionTable", "blade_deflection_table"]
 
 RATED = {
@@ -559,6 +559,40 @@ def inclined_rotor_moment(wind_speed: float) -> tuple[float, float]:
     bent = np.asarray(data["yaw_moment_change_Nm"]["bent"], dtype=float) / dw
     per_m = (bent - straight) / float(data["tip_deflection_m"])
     return float(np.interp(wind_speed, v, straight)), float(np.interp(wind_speed, v, per_m))
+
+
+def inclined_rotor_moment_by_pitch() -> tuple[np.ndarray, np.ndarray]:
+    """The straight-bladed inclined rotor's moment per m/s of in-plane wind along the pitch-regulated operating
+    points, indexed by their blade pitch (rad; N m per m/s, one blade's share as :func:`inclined_rotor_moment`).
+
+    Above rated the blade pitch is what sets how the blades meet the in-plane wind: AeroDyn's moment per m/s of it
+    falls from +88 kN m per m/s (one blade) at fine pitch to -213 at 17 deg (``tools/inclined_rotor_inplane_table.py``).
+    A rotor whose pitch moves (the controller answering the platform's slow surge and pitch in steady wind, or the
+    turbulence) moves along this curve: the simulation's nonlinear rotor reads it at the blade's instantaneous
+    pitch, relative to the equilibrium's, and the linear model takes its slope there. The nodes are the table's
+    operating points from the last fine-pitch one (11 m/s) up; the curve is linear in pitch between them and held
+    beyond them. In OpenFAST's steady 12 m/s run with the platform's yaw held the slow (< 0.05 Hz) yaw-bearing
+    moment follows the blade pitch at -36 kN m/deg (correlation -0.88); this curve's slope there, times 1.5 and the
+    run's in-plane wind (2.1 m/s), is -30 kN m/deg.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        Blade pitch of the nodes (rad, increasing from 0) and ``k_straight`` there (N m per m/s).
+
+    Examples
+    --------
+    >>> beta, k = inclined_rotor_moment_by_pitch()
+    >>> float(beta[0]), round(1.5 * float(np.interp(np.deg2rad(3.12), beta, k)) / 1e3)  # at 12 m/s's pitch
+    (0.0, 87)
+    """
+    data = _inclined_rotor_json()
+    v = np.asarray(data["wind_speed"], dtype=float)
+    pitch = np.deg2rad(np.asarray(data["pitch_deg"], dtype=float))
+    t0, t1 = (np.deg2rad(float(a)) for a in data["inclinations_deg"])
+    straight = np.asarray(data["yaw_moment_change_Nm"]["straight"], dtype=float) / (1.5 * v * (np.sin(t1) - np.sin(t0)))
+    first = int(np.flatnonzero(pitch <= 0.0)[-1])
+    return pitch[first:].copy(), straight[first:].copy()
 
 
 def inclined_rotor_inplane(wind_speed: float) -> tuple[float, float]:

@@ -47,6 +47,7 @@ from .aero import (
     blade_inplane_gain,
     inclined_rotor_inplane,
     inclined_rotor_moment,
+    inclined_rotor_moment_by_pitch,
     operating_point,
     skew_gains,
 )
@@ -562,6 +563,16 @@ class FOWTModel:
             per_wz += j_hub.T @ np.array([0.0, g_ip * eps, 0.0])
             per_wy += j_hub.T @ np.array([0.0, 0.0, -g_ip * eps])
             v0, gain = lc.wind_speed, 1.5 * s_skew
+            # the moment per m/s of in-plane wind follows the blade pitch (inclined_rotor_moment_by_pitch): its
+            # slope at the operating pitch times the mean in-plane wind up the disc, on the pitch's deviation
+            beta_k, k_beta = inclined_rotor_moment_by_pitch()
+            h_beta = np.deg2rad(0.5)
+            dk_dbeta = float(np.interp(op.pitch + h_beta, beta_k, k_beta)
+                             - np.interp(max(op.pitch - h_beta, 0.0), beta_k, k_beta)) / (
+                op.pitch + h_beta - max(op.pitch - h_beta, 0.0))
+            m_beta = gain * v0 * np.sin(inc0) * dk_dbeta * (r_tt.T @ np.array([0.0, 0.0, 1.0]))
+            f_x += np.outer(m_beta, pitch_x)
+            f_u[:, ia] += m_beta
             f_x[:, _FLAP] += (gain * v0 * np.sin(inc0) * s_bend * e1 * g_ip) * (j_hub.T @ np.array([0.0, 1.0, 0.0]))
             e_up = st.disc_up
             f_u[:, 0] += gain * v0 * (np.sin(inc0) - np.cos(inc0) * theta0) * per_wz

@@ -32,6 +32,7 @@ from .aero import (
     blade_inplane_sensitivity,
     inclined_rotor_inplane,
     inclined_rotor_moment,
+    inclined_rotor_moment_by_pitch,
     inplane_ring_weights,
     operating_point,
     rotor_coefficients,
@@ -159,8 +160,11 @@ def _blade_wind_columns(wind: RotorWind, wind_speed: float) -> np.ndarray:
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
     P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP, P_PHIT, P_VT, P_WT, \
     P_VY, P_WY, P_FIP, P_SPINC, P_SSKEW, P_SKT, P_SKM, P_SKF, P_SBEND, P_DBEND, P_SCURV, P_INCF0, \
-    P_INCF1, P_LAGC, P_LAGS = range(43)
-N_PAR = 43
+    P_INCF1, P_LAGC, P_LAGS, P_SKMN, P_SKMB = range(45)
+N_SKM_NODES = 16
+P_SKM_PITCH = 45
+P_SKM_K = P_SKM_PITCH + N_SKM_NODES
+N_PAR = P_SKM_K + N_SKM_NODES
 """(P_PHIT: the blade's flap mode at the thrust's centre, ``BladeFlapMode.thrust_shape``; P_VT, P_WT, P_VY, P_WY:
 :func:`surrogates.model.cyclic_flap_aero_shares`; P_FIP: the in-plane force's share of a blade's tip flap velocity,
 its gain-weighted mean of the flap shape; P_SPINC: ``c / J`` of :func:`surrogates.model.rotor_free_inertia`, how the
@@ -170,7 +174,9 @@ rotor speed relative to the nacelle answers the nacelle's roll about the shaft; 
 ``blade_deflection`` and the tip deflection (m) of :func:`surrogates.aero.blade_deflection_table`'s bent blades;
 P_SCURV: strength of ``sampled_wind_curvature``; P_INCF0, P_INCF1: the in-plane force's share of the rotor's
 in-plane wind, straight blades and per metre of tip deflection, :func:`surrogates.aero.inclined_rotor_inplane`;
-P_LAGC, P_LAGS: cosine and sine of :data:`surrogates.model.DISC_RATE_LAG_DEG`.)"""
+P_LAGC, P_LAGS: cosine and sine of :data:`surrogates.model.DISC_RATE_LAG_DEG`; P_SKMN, P_SKMB: the number of nodes
+of :func:`surrogates.aero.inclined_rotor_moment_by_pitch` (0: P_SKM held) and its value at the equilibrium's pitch;
+its nodes' pitch (rad) from P_SKM_PITCH and moment per m/s of in-plane wind from P_SKM_K, N_SKM_NODES slots each.)"""
 I_ACC = N_CONTROLLER_STATE
 """Slots of the stepper's carried state ``ctrl`` after the controller's: the platform's heave, roll and pitch
 accelerations of the previous internal step (m/s^2, rad/s^2), which the CM kinematics (``cm_kinematics``) read."""
@@ -346,6 +352,20 @@ def _mooring_generalised(x, gx, gy, gyaw, tab, zf, out):
 
 
 @numba.njit(cache=True, nogil=True)
+def _by_pitch(par, n, pitch):
+    """Linear interpolation of the P_SKM_K nodes over the P_SKM_PITCH nodes at ``pitch`` (rad), held beyond them."""
+    b0 = P_SKM_PITCH
+    k0 = P_SKM_K
+    if pitch <= par[b0]:
+        return par[k0]
+    for i in range(1, n):
+        if pitch <= par[b0 + i]:
+            f = (pitch - par[b0 + i - 1]) / (par[b0 + i] - par[b0 + i - 1])
+            return par[k0 + i - 1] + f * (par[k0 + i] - par[k0 + i - 1])
+    return par[k0 + n - 1]
+
+
+@numba.njit(cache=True, nogil=True)
 def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_along, drag_across, drag_dir, moor_gx,
            moor_gy, moor_gyaw, moor_tab, moor_g0,
            moor_jac, moor_out, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab, cq_tab, ctb_tab, cqb_tab, par,
@@ -486,8 +506,14 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
             w_y = 1.5 * s_skew * (-wind * math.sin(yaw) - par[P_SAERO] * v_y)
             u[hub0 + 1] += -par[P_SKF] * w_y
             u[hub0 + 2] += -par[P_SKF] * w_z
-            u[hub0 + 4] += par[P_SKM] * w_y
-            u[hub0 + 5] += par[P_SKM] * w_z
+            # the moment per m/s of in-plane wind follows the blade pitch along AeroDyn's operating points
+            # (inclined_rotor_moment_by_pitch), relative to the equilibrium's
+            k_m = par[P_SKM]
+            n_sk = int(par[P_SKMN])
+            if n_sk > 1:
+                k_m += _by_pitch(par, n_sk, pitch) - par[P_SKMB]
+            u[hub0 + 4] += k_m * w_y
+            u[hub0 + 5] += k_m * w_z
             u[nl0 + _CYCLIC[0]] += par[P_PHIT] * par[P_WT] * par[P_SKT] * w_y
             u[nl0 + _CYCLIC[1]] += par[P_PHIT] * par[P_WY] * par[P_SKT] * w_z
         # rotationally sampled turbulence: each blade's wind departs from the disc mean; linear blade loads give
@@ -835,7 +861,7 @@ class Simulator:
             else:
                 pitch = None
         model._operating_states[key] = (pitch, self.x_eq.copy(), self.ctrl0[:N_CONTROLLER_STATE].copy(),
-                                        self.par[[P_SKT, P_SKF, P_SKM]].copy())
+                                        self.par[[P_SKT, P_SKF, P_SKM, P_SKMB, P_SKMN]].copy())
 
     def _build(self, warm: tuple[np.ndarray, np.ndarray] | None = None,
                state: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> None:
@@ -885,6 +911,7 @@ class Simulator:
         ])
         d = st.data
         par = np.zeros(N_PAR)
+        n_by_pitch = 0  # nodes of inclined_rotor_moment_by_pitch (set with the nonlinear rotor)
         par[P_DT] = self.dt_int
         par[P_PHIT] = st.data.blade_flap.thrust_shape
         par[P_SMOOR] = float(eff["mooring_nonlinear"])
@@ -923,6 +950,10 @@ class Simulator:
             par[P_SCURV] = float(eff["sampled_wind_curvature"])
             par[P_INCF0], par[P_INCF1] = inclined_rotor_inplane(self.case.wind_speed)
             par[P_LAGC], par[P_LAGS] = math.cos(DISC_RATE_LAG), math.sin(DISC_RATE_LAG)
+            beta_k, k_beta = inclined_rotor_moment_by_pitch()
+            n_by_pitch = beta_k.size
+            par[P_SKM_PITCH:P_SKM_PITCH + beta_k.size] = beta_k
+            par[P_SKM_K:P_SKM_K + beta_k.size] = k_beta
         if op is not None and self.nonlinear_rotor:
             par[P_SBEND] = float(eff["blade_deflection"])
             par[P_DBEND] = bent.tip_deflection
@@ -939,7 +970,7 @@ class Simulator:
         if state is not None:
             self.x_eq = np.array(state[0], dtype=float)
             self.ctrl0[:N_CONTROLLER_STATE] = state[1]
-            par[[P_SKT, P_SKF, P_SKM]] = state[2]
+            par[[P_SKT, P_SKF, P_SKM, P_SKMB, P_SKMN]] = state[2]
             return
         if warm is not None and op is not None:
             self.ctrl0[:N_CONTROLLER_STATE] = warm[1][:N_CONTROLLER_STATE]
@@ -950,7 +981,15 @@ class Simulator:
             # the moment from AeroDyn (skewed wake, cone), at the equilibrium's flap deflection
             m0, m1 = inclined_rotor_moment(self.case.wind_speed)
             par[P_SKM] = m0 + float(eff["blade_deflection"]) * m1 * float(self.x_eq[FLAP])
+            n_sk = n_by_pitch
+            if n_sk > 1:  # the pitch-indexed moment, relative to the equilibrium's pitch (its nodes set above)
+                par[P_SKMN] = n_sk
+                par[P_SKMB] = float(np.interp(self.ctrl0[2], par[P_SKM_PITCH:P_SKM_PITCH + n_sk],
+                                              par[P_SKM_K:P_SKM_K + n_sk]))
             self.x_eq = self._equilibrium(self.x_eq)
+            if n_sk > 1:  # ... at the pitch of the equilibrium found with it (it moves by ~0.01 deg)
+                par[P_SKMB] = float(np.interp(self.ctrl0[2], par[P_SKM_PITCH:P_SKM_PITCH + n_sk],
+                                              par[P_SKM_K:P_SKM_K + n_sk]))
 
     def mean_operating_pitch(self) -> float:
         """Mean platform pitch (rad) of a simulation of this load case: the equilibrium's (the controller's steady
