@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import surrogates
-from surrogates.aero import blade_skew_table, inclined_rotor_moment, skew_gains
+from surrogates.aero import blade_skew_table, inclined_rotor_moment, inclined_rotor_moment_by_pitch, skew_gains
 from surrogates.load_cases import load_case
 from surrogates.simulate import I_HUB, N_EX, P_GIP, P_INCF0, P_INCF1, P_SKF, P_SKM, P_SKT, Simulator
 from surrogates.structure import N_DOF
@@ -99,6 +99,33 @@ def test_an_inclined_rotor_carries_three_halves_of_one_blades_moment_times_the_i
     w_z = 12.0 * math.sin(-st.data.shaft_tilt_rad)  # the shaft's own tilt still inclines the rotor
     assert d[1] == pytest.approx(-1.5 * g_f * w_y + 1.5 * g_ip * eps0 * w_z, rel=1e-9)
     assert d[2] == pytest.approx(-1.5 * g_f * w_z - 1.5 * g_ip * eps0 * w_y, rel=1e-9)
+
+
+def test_the_inclined_rotors_moment_follows_the_blade_pitch_from_the_equilibriums():
+    """At the equilibrium's pitch the moment per m/s of in-plane wind is the case's (P_SKM); 2 deg of pitch further
+    it has moved along AeroDyn's operating points (inclined_rotor_moment_by_pitch) by the table's change between
+    the two pitches, and falls as AeroDyn's does above rated (87 kN m per m/s at 3.1 deg, 15 at 6 deg)."""
+    case = load_case(7).replace(wind_speed=14.0)
+    on, off = surrogates.FOWTModel(), surrogates.FOWTModel().with_effects(rotor_skew=0.0)
+    sim = Simulator(on, case)
+    st = sim.system.structure
+    x = np.zeros_like(sim.x_eq)
+    x[4] = math.radians(4.0)
+    w_z = 14.0 * math.sin(float(st.tower_top_rotation[1] @ x[:N_DOF]) - st.data.shaft_tilt_rad)
+    beta, k = inclined_rotor_moment_by_pitch()
+    pitch0 = float(sim.ctrl0[2])
+    assert 0.1 < pitch0 < 0.2  # rad: above rated, the blades regulate (8.2 deg aligned; less inclined and bent)
+    moments = []
+    for dp in (0.0, math.radians(2.0)):
+        ctrl = sim.ctrl0.copy()
+        ctrl[2] = pitch0 + dp
+        d = _hub_loads(on, case, x, ctrl) - _hub_loads(off, case, x, ctrl)
+        moments.append(d[5])
+    g_m = float(sim.par[P_SKM])
+    assert moments[0] == pytest.approx(1.5 * g_m * w_z, rel=1e-9)
+    shift = float(np.interp(pitch0 + math.radians(2.0), beta, k) - np.interp(pitch0, beta, k))
+    assert shift < 0.0
+    assert moments[1] == pytest.approx(1.5 * (g_m + shift) * w_z, rel=1e-9)
 
 
 def test_the_linear_model_holds_the_same_mean_yaw_as_the_nonlinear_rotor():
