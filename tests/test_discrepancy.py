@@ -163,12 +163,27 @@ def _recovered(rep, name, truth):
 # the cases .ci/run checks on every change; the rest carry the `matrix` mark and are run by hand (about 25 minutes
 # of CPU): `python -m pytest -m slow tests/test_discrepancy.py` or `python tools/discrepancy_hidden_truths.py`
 CI_PARAMETER_TRUTHS = {("tower_fa_stiffness", 0.90), ("mooring_line_2", 0.60)}
+# the truths the statistics no longer establish on issue 15's physics (measured at 2c80b68 and again after the
+# inclined rotor's moment followed the blade pitch, the same answers to two digits; README, "Detection limits")
+MISSED_PARAMETER_TRUTHS = {
+    ("tower_fa_stiffness", 0.95): "named 0.92 (0.83-1.00 excl.), but its gap before, 2.6, is under the level 2.85",
+    ("platform_mass", 1.03): "not seen: gap 2.4-2.5 under the level 2.7",
+    ("structural_damping", 2.0): "not seen: gap 1.6 under the level 2.8",
+    ("structural_damping", 0.3): "not seen: gap 1.7 under the level 2.7",
+}
+
+
+def _truth_marks(row: tuple) -> list:
+    marks = [] if row[:2] in CI_PARAMETER_TRUTHS else [pytest.mark.matrix]
+    if row[:2] in MISSED_PARAMETER_TRUTHS:
+        marks.append(pytest.mark.xfail(strict=True, reason=MISSED_PARAMETER_TRUTHS[row[:2]]))
+    return marks
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize(("name", "truth", "olc", "seed"), [
     pytest.param(*row, id=f"{row[0]}={row[1]}-" + (f"OLC{row[2]}" if isinstance(row[2], int) else "parked_swell"),
-                 marks=() if row[:2] in CI_PARAMETER_TRUTHS else pytest.mark.matrix)
+                 marks=_truth_marks(row))
     for row in PARAMETER_TRUTHS])
 def test_a_hidden_parameter_change_is_recovered_within_its_interval(name, truth, olc, seed):
     case = _case(olc)
