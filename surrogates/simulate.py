@@ -981,15 +981,14 @@ class Simulator:
             # the moment from AeroDyn (skewed wake, cone), at the equilibrium's flap deflection
             m0, m1 = inclined_rotor_moment(self.case.wind_speed)
             par[P_SKM] = m0 + float(eff["blade_deflection"]) * m1 * float(self.x_eq[FLAP])
-            n_sk = n_by_pitch
-            if n_sk > 1:  # the pitch-indexed moment, relative to the equilibrium's pitch (its nodes set above)
-                par[P_SKMN] = n_sk
-                par[P_SKMB] = float(np.interp(self.ctrl0[2], par[P_SKM_PITCH:P_SKM_PITCH + n_sk],
-                                              par[P_SKM_K:P_SKM_K + n_sk]))
+            # the pitch-indexed moment (its nodes set above), relative to the equilibrium's pitch; read by the
+            # kernel's own interpolation, then again at the pitch of the equilibrium found with it (~0.01 deg on)
+            par[P_SKMN] = n_by_pitch
+            if n_by_pitch > 1:
+                par[P_SKMB] = _by_pitch(par, n_by_pitch, float(self.ctrl0[2]))
             self.x_eq = self._equilibrium(self.x_eq)
-            if n_sk > 1:  # ... at the pitch of the equilibrium found with it (it moves by ~0.01 deg)
-                par[P_SKMB] = float(np.interp(self.ctrl0[2], par[P_SKM_PITCH:P_SKM_PITCH + n_sk],
-                                              par[P_SKM_K:P_SKM_K + n_sk]))
+            if n_by_pitch > 1:
+                par[P_SKMB] = _by_pitch(par, n_by_pitch, float(self.ctrl0[2]))
 
     def mean_operating_pitch(self) -> float:
         """Mean platform pitch (rad) of a simulation of this load case: the equilibrium's (the controller's steady
