@@ -40,12 +40,9 @@ whose ``.outb`` exists is not run again.
 
 from __future__ import annotations
 
-import argparse
 import json
 import re
-import subprocess
 import sys
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -84,45 +81,33 @@ def _edit(path: Path, **values: object) -> None:
     path.write_text(text)
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--openfast-build", required=True, type=Path, help="cmake build tree (openfast)")
-    ap.add_argument("--work", required=True, type=Path, help="working copy of the shared decks and the runs")
-    ap.add_argument("--shared", default=REPO.parent / "shared", type=Path)
-    ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--out", default=DEFAULT_OUT, type=Path)
-    args = ap.parse_args(argv)
+def _build(name: str) -> dict:
+    """``make_runs.build``'s spec of run ``name``: every platform DOF off at PLATFORM_PITCH_DEG, steady wind."""
+    spec = _runs()[name]
+    ed = {**dict.fromkeys(HELD, "False"), "PtfmPitch": PLATFORM_PITCH_DEG, "PtfmSurge": 0, "RotSpeed": 12.1,
+          "BlPitch": 0.0}
+    if spec["rigid"]:
+        ed.update(FlapDOF1="False", FlapDOF2="False", EdgeDOF="False")
+    return dict(TMax=WINDOW_S[1], TStart=0, wind=("steady", spec["wind"]), sea=dict(WaveMod=0), ed=ed)
 
+
+def _edit_run(rd: Path, name: str) -> None:
+    """What the shared generator does not set: no sea, hydrodynamics or mooring, 20 Hz output, the run's shear."""
+    _edit(rd / f"{name}.fst", CompSeaSt=0, CompHydro=0, CompMooring=0, DT_Out=0.05)
+    _edit(rd / f"{name}_InflowWind.dat", PLExp=_runs()[name]["shear"])
+
+
+def main(argv: list[str] | None = None) -> int:
     sys.path.insert(0, str(REPO))
     sys.path.insert(0, str(REPO / "tools"))
     from compact_openfast_reference import sha256
-    from openfast_heldout_runs import working_copy
+    from openfast_time_domain_runs import build_and_run
 
     from fowt_env.io import load_record
 
-    work: Path = args.work
-    env = working_copy(args.shared, work, args.openfast_build)
-    sys.path.insert(0, str(work / "tools"))
-    import make_runs  # the shared run generator (its deck paths resolve inside the working copy)
-
     runs = _runs()
-
-    def one(name: str) -> str:
-        spec = runs[name]
-        ed = {**dict.fromkeys(HELD, "False"), "PtfmPitch": PLATFORM_PITCH_DEG, "PtfmSurge": 0, "RotSpeed": 12.1,
-              "BlPitch": 0.0}
-        if spec["rigid"]:
-            ed.update(FlapDOF1="False", FlapDOF2="False", EdgeDOF="False")
-        rd = Path(make_runs.build(name, dict(TMax=WINDOW_S[1], TStart=0, wind=("steady", spec["wind"]),
-                                             sea=dict(WaveMod=0), ed=ed)))
-        _edit(rd / f"{name}.fst", CompSeaSt=0, CompHydro=0, CompMooring=0, DT_Out=0.05)
-        _edit(rd / f"{name}_InflowWind.dat", PLExp=spec["shear"])
-        if not (rd / f"{name}.outb").is_file():
-            subprocess.run(["bash", str(work / "tools" / "run_case.sh"), name], env=env, check=True)
-        return name
-
-    with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        names = list(pool.map(one, runs))
+    args, work, names = build_and_run(argv, __doc__, {name: _build(name) for name in runs}, DEFAULT_OUT,
+                                      edit=_edit_run)
 
     out: dict = {"created_by": "tools/openfast_quasi_static_runs.py",
                  "source": "the shared OC3 Hywind deck (OpenFAST v5.0.0, 2895884d), every platform DOF off at "

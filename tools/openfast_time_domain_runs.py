@@ -87,12 +87,12 @@ def main(argv: list[str] | None = None) -> int:
     return run_and_package(argv, __doc__, RUNS, case_of, CHANNELS, DEFAULT_OUT, "tools/openfast_time_domain_runs.py")
 
 
-def run_and_package(argv: list[str] | None, doc: str, runs: dict, case_of: Callable[[str], dict],
-                    channels: tuple[str, ...], default_out: Path, created_by: str,
-                    transform: Callable[[Record], Record] | None = None) -> int:
-    """The command line of the OpenFAST run tools: build each of ``runs`` (``make_runs.build`` of the shared
-    decks, in a working copy), run those without an ``.outb``, write their ``case.json`` (``case_of(name)``) and
-    :func:`package` them, each record passed through ``transform`` first if given."""
+def build_and_run(argv: list[str] | None, doc: str, runs: dict, default_out: Path,
+                  edit: Callable[[Path, str], None] | None = None) -> tuple[argparse.Namespace, Path, list[str]]:
+    """The command line shared by the OpenFAST run tools: a working copy of the shared decks (``--work``), each of
+    ``runs`` built there by ``make_runs.build`` (then ``edit(run_dir, name)`` if given, for deck changes the shared
+    generator does not make) and run with OpenFAST unless its ``.outb`` exists. Returns the parsed arguments, the
+    working copy and the run names."""
     ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--openfast-build", required=True, type=Path, help="cmake build tree (openfast)")
     ap.add_argument("--work", required=True, type=Path, help="working copy of the shared decks and the runs")
@@ -111,15 +111,26 @@ def run_and_package(argv: list[str] | None, doc: str, runs: dict, case_of: Calla
     import make_runs  # the shared run generator (its deck paths resolve inside the working copy)
 
     def one(name: str) -> str:
-        make_runs.build(name, runs[name])
-        rd = work / "runs" / name
+        rd = Path(make_runs.build(name, runs[name]))
+        if edit is not None:
+            edit(rd, name)
         if not (rd / f"{name}.outb").is_file():
             subprocess.run(["bash", str(work / "tools" / "run_case.sh"), name], env=env, check=True)
-        (rd / f"{name}.case.json").write_text(json.dumps(case_of(name), indent=1) + "\n")
         return name
 
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         names = list(pool.map(one, runs))
+    return args, work, names
+
+
+def run_and_package(argv: list[str] | None, doc: str, runs: dict, case_of: Callable[[str], dict],
+                    channels: tuple[str, ...], default_out: Path, created_by: str,
+                    transform: Callable[[Record], Record] | None = None) -> int:
+    """:func:`build_and_run` of ``runs``, then each run's ``case.json`` (``case_of(name)``) and :func:`package`
+    of them, each record passed through ``transform`` first if given."""
+    args, work, names = build_and_run(argv, doc, runs, default_out)
+    for name in names:
+        (work / "runs" / name / f"{name}.case.json").write_text(json.dumps(case_of(name), indent=1) + "\n")
     package(work, names, args.out, channels, created_by, transform)
     return 0
 
