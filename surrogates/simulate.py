@@ -654,7 +654,7 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
 
 
 @numba.njit(cache=True, nogil=True)
-def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, vel, blade, strip_z, drag_coef,
+def _advance(x, ctrl, psi, k0, n_steps, every, phi_t, g_rest_t, exo, u_ex, action, vel, blade, strip_z, drag_coef,
              drag_along,
              drag_across, drag_dir, moor_gx,
              moor_gy, moor_gyaw, moor_tab, moor_g0, moor_jac, harm, e_s, h_v, r_pitch, tsr_grid, pitch_grid, ct_tab,
@@ -668,7 +668,7 @@ def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, v
     controller state ``ctrl`` are updated in place; the new rotor azimuth is returned.
     """
     n_x = x.shape[0]
-    n_r = g_rest.shape[1]
+    n_r = g_rest_t.shape[0]
     u = np.zeros(N_EX + n_r)
     xn = np.zeros(n_x)
     n_out = 0
@@ -694,13 +694,18 @@ def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, v
             for i in range(n_r):
                 u_hist[row, i] = u[N_EX + i]
             n_out += 1
+        # xn = exo[k] + phi x + g_rest u, column by column: each xn[r] sums in the same order as a row-wise dot
+        # product (so the same bits), while the inner loop over r runs in SIMD lanes
         for r in range(n_x):
-            acc = exo[k, r]
-            for i in range(n_x):
-                acc += phi[r, i] * x[i]
-            for i in range(n_r):
-                acc += g_rest[r, i] * u[N_EX + i]
-            xn[r] = acc
+            xn[r] = exo[k, r]
+        for i in range(n_x):
+            xi = x[i]
+            for r in range(n_x):
+                xn[r] += phi_t[i, r] * xi
+        for i in range(n_r):
+            ui = u[N_EX + i]
+            for r in range(n_x):
+                xn[r] += g_rest_t[i, r] * ui
         psi += (harm[3] + x[2 * N_DOF]) * dt
         for i in range(3):  # heave, roll, pitch accelerations over the step, for the next step's CM kinematics
             ctrl[I_ACC + i] = (xn[N_DOF + 2 + i] - x[N_DOF + 2 + i]) / dt
@@ -715,6 +720,36 @@ def _advance(x, ctrl, psi, k0, n_steps, every, phi, g_rest, exo, u_ex, action, v
             x[2 * N_DOF] += domega * dt - par[P_SPINC] * droll
             discon_step(discon, ctrl, par[P_NGEAR] * (par[P_OMEGA0] + x[2 * N_DOF]), dt)
     return psi
+
+
+@numba.njit(cache=True, nogil=True)
+def _interp_columns(t, delay, t_field, values, out):
+    """``out[:, c] = np.interp(t - delay[c], t_field, values[:, c])`` for every column, with numpy's arithmetic
+    (the same interval, the same precomputed slopes and end values; so the same numbers), for increasing ``t``
+    and ``t_field``: each column's interval advances with ``t`` instead of being searched for."""
+    n_f = t_field.size
+    n_c = values.shape[1]
+    slopes = np.empty((max(n_f - 1, 0), n_c))
+    for j in range(n_f - 1):
+        for c in range(n_c):
+            slopes[j, c] = (values[j + 1, c] - values[j, c]) / (t_field[j + 1] - t_field[j])
+    at = np.zeros(n_c, dtype=np.int64)  # each column's interval, advancing with t
+    for i in range(t.size):
+        for c in range(n_c):
+            xv = t[i] - delay[c]
+            if xv <= t_field[0]:
+                out[i, c] = values[0, c]
+            elif xv >= t_field[n_f - 1]:
+                out[i, c] = values[n_f - 1, c]
+            else:
+                j = at[c]
+                while t_field[j + 1] <= xv:
+                    j += 1
+                at[c] = j
+                if xv == t_field[j]:
+                    out[i, c] = values[j, c]
+                else:
+                    out[i, c] = slopes[j, c] * (xv - t_field[j]) + values[j, c]
 
 
 @numba.njit(cache=True, nogil=True)
@@ -873,6 +908,8 @@ class Simulator:
         eff = model.effects
         disc = _discretise(self.system, self.dt_int)
         self.phi, self.g_ex0, self.g_ex1, self.g_rest = disc.phi, disc.g_ex0, disc.g_ex1, disc.g_rest
+        # the stepper reads them column by column (_advance)
+        self._phi_t, self._g_rest_t = np.ascontiguousarray(disc.phi.T), np.ascontiguousarray(disc.g_rest.T)
         self.cy = np.ascontiguousarray(self.system.C)
         self._i_roll, self._i_pitch, self._i_yaw = (ALL_CHANNELS.index(c) for c in ("PtfmRoll", "PtfmPitch", "PtfmYaw"))
         self.dy = np.ascontiguousarray(self.system.D)
@@ -1207,7 +1244,7 @@ class Simulator:
                 exo: np.ndarray, u_ex: np.ndarray, action: np.ndarray, vel: np.ndarray, blade: np.ndarray,
                 x_hist: np.ndarray, u_hist: np.ndarray, out0: int) -> float:
         """Run the compiled stepper (``x`` and ``ctrl`` in place); returns the new rotor azimuth (rad)."""
-        return _advance(x, ctrl, psi, k0, n_steps, every, self.phi, self.g_rest, exo, u_ex, action, vel, blade,
+        return _advance(x, ctrl, psi, k0, n_steps, every, self._phi_t, self._g_rest_t, exo, u_ex, action, vel, blade,
                         self.strip_z, *self.drag_arrays, *self.moor_grids, self.moor_tab, self.moor_g0, self.moor_jac,
                         self.harm, self.e_s, self.h_v, self.r_pitch, *self.rotor_grids, self.discon, self.par,
                         x_hist, u_hist, out0)
@@ -1281,8 +1318,7 @@ class Simulator:
             delay = np.tile(self.blade_sampling_delay(), 2)
             t_field = np.arange(on_blade.shape[0]) * FIELD_DT
             blade = np.empty((n, on_blade.shape[1]), dtype=np.float32)
-            for c in range(on_blade.shape[1]):  # held at the field's ends, as in a replay
-                blade[:, c] = np.interp(t - delay[c], t_field, on_blade[:, c])
+            _interp_columns(t, delay, t_field, np.ascontiguousarray(on_blade, dtype=float), blade)
         psi0 = float(np.random.default_rng(psi_ss).uniform(0.0, 2.0 * np.pi))
         return np.ascontiguousarray(u_ex), vel, psi0, np.ascontiguousarray(blade)
 
@@ -1293,7 +1329,9 @@ class Simulator:
     def outputs(self, x_hist: np.ndarray, u_ex_out: np.ndarray, u_hist: np.ndarray) -> np.ndarray:
         """Channel values ``C x + D u`` from stored states and inputs (n, 55), with ``PtfmRoll`` and ``PtfmYaw`` as
         ElastoDyn reports them (:func:`elastodyn_platform_angles`)."""
-        y = x_hist @ self.cy.T + u_ex_out @ self.dy[:, :N_EX].T + u_hist @ self.dy[:, N_EX:].T
+        y = x_hist @ self.cy.T  # then added in place: the same sums as one expression, without its temporaries
+        y += u_ex_out @ self.dy[:, :N_EX].T
+        y += u_hist @ self.dy[:, N_EX:].T
         elastodyn_platform_angles(y, self._i_roll, self._i_pitch, self._i_yaw, self.system.mean_pitch)
         return y
 

@@ -409,19 +409,53 @@ def _wave_transfer_rows(f: np.ndarray, depth: float, geo: SparGeometry, z: np.nd
     return rows
 
 
+@lru_cache(maxsize=8)
+def _transfer_rows_on_grid(n_fft: int, dt: float, first: int, count: int, depth: float, geo: SparGeometry,
+                           z_key: bytes) -> np.ndarray:
+    z = np.frombuffer(z_key, dtype=float)
+    freqs = np.fft.rfftfreq(n_fft, dt)[first:first + count]
+    rows = _wave_transfer_rows(freqs, depth, geo, z)
+    rows.setflags(write=False)
+    return rows
+
+
+def _cached_transfer_rows(n_fft: int, dt: float, active: np.ndarray, depth: float, geo: SparGeometry,
+                          z: np.ndarray) -> np.ndarray:
+    """:func:`_wave_transfer_rows` at the FFT grid's bins ``active`` (``rfftfreq(n_fft, dt)[active]``), read-only.
+    A contiguous run of bins (a JONSWAP spectrum's, cut below a fraction of its peak) is kept for the next call
+    with the same grid: a batch of seeds (or a campaign) of one sea state meets the same grid every time, and the
+    Bessel functions and depth kernels behind the rows are most of a draw's cost besides its FFTs. The rows do
+    not depend on the seed, ``hs``, ``tp`` or ``gamma``."""
+    if active.size and int(active[-1]) - int(active[0]) + 1 == active.size:
+        return _transfer_rows_on_grid(int(n_fft), float(dt), int(active[0]), int(active.size), float(depth), geo,
+                                      np.ascontiguousarray(z, dtype=float).tobytes())
+    return _wave_transfer_rows(np.fft.rfftfreq(n_fft, dt)[active], depth, geo, z)
+
+
 def _loads_from_transfer_series(series: np.ndarray, beta: float) -> tuple[np.ndarray, np.ndarray]:
     """Platform excitation (n, 6) and strip velocities (n, n_strips, 2) from the time series of the rows of
-    :func:`_wave_transfer_rows` (elevation, F_along, M_along, Fz, strip velocities) for waves travelling along
-    ``beta`` (rad from +x towards +y): the along-wave force and moment and the velocities resolved on x and y."""
-    cb, sb = np.cos(beta), np.sin(beta)
-    excitation = np.zeros((series.shape[0], 6))
-    excitation[:, 0] = series[:, 1] * cb
-    excitation[:, 1] = series[:, 1] * sb
-    excitation[:, 2] = series[:, 3]
-    excitation[:, 3] = -series[:, 2] * sb
-    excitation[:, 4] = series[:, 2] * cb
-    return excitation, series[:, 4:, None] * np.array([cb, sb])
+    :func:`_wave_transfer_rows` (elevation, F_along, M_along, Fz, strip velocities), shape (n, 4 + n_strips),
+    for waves travelling along ``beta`` (rad from +x towards +y): the along-wave force and moment and the
+    velocities resolved on x and y."""
+    return _loads_from_transfer_rows(series.T, beta)
 
+
+def _loads_from_transfer_rows(rows: np.ndarray, beta: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_loads_from_transfer_series` from the series as rows, shape (4 + n_strips, n) (as an inverse FFT
+    along the last axis gives them: read row by row, without a transposed copy)."""
+    cb, sb = np.cos(beta), np.sin(beta)
+    n = rows.shape[1]
+    excitation = np.zeros((n, 6))
+    excitation[:, 0] = rows[1] * cb
+    excitation[:, 1] = rows[1] * sb
+    excitation[:, 2] = rows[3]
+    excitation[:, 3] = -rows[2] * sb
+    excitation[:, 4] = rows[2] * cb
+    velocity = np.empty((n, rows.shape[0] - 4, 2))
+    strips = rows[4:].T
+    velocity[:, :, 0] = strips * cb
+    velocity[:, :, 1] = strips * sb
+    return excitation, velocity
 
 def excitation_rao(
     f_hz: np.ndarray,
@@ -628,15 +662,15 @@ def synthesize_waves(
     fa = freqs[active]
     amp = np.sqrt(2.0 * spec[active] * df) * np.exp(1j * phases[active])
 
-    rows = _wave_transfer_rows(fa, depth, geo, z)
+    rows = _cached_transfer_rows(n_fft, dt, active, depth, geo, z)
     # irfft gives (1/N) sum_j X_j e^{2 pi i j m / N} + c.c., so N/2 X_j makes sum_j Re(X_j e^{i w_j t}); bins
     # above the last active one are zero-padded by irfft itself
     n_used = int(active[-1]) + 1 if active.size else 1
     spectra = np.zeros((rows.shape[0], n_used), dtype=complex)
     spectra[:, active] = rows * (amp * (0.5 * n_fft))
-    series = np.ascontiguousarray(irfft(spectra, n=n_fft, axis=-1)[:, :n_out].T)  # (n, 4 + n_strips)
+    series = irfft(spectra, n=n_fft, axis=-1)[:, :n_out]  # (4 + n_strips, n)
 
-    excitation, velocity = _loads_from_transfer_series(series, np.deg2rad(direction))
+    excitation, velocity = _loads_from_transfer_rows(series, np.deg2rad(direction))
     meta = {
         "hs": hs, "tp": tp, "gamma": gamma, "direction_deg": direction,
         "seed": int(seed) if isinstance(seed, int | np.integer) else None, "depth": depth, "dt": dt,
@@ -644,7 +678,7 @@ def synthesize_waves(
     }
     return WaveLoads(
         t=np.arange(n_out) * dt,
-        elevation=series[:, 0].copy(),
+        elevation=series[0].copy(),
         excitation=excitation,
         strip_z=z,
         strip_dz=dz,

@@ -26,6 +26,8 @@ True
 
 from __future__ import annotations
 
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from functools import lru_cache
 
@@ -543,11 +545,43 @@ def _coherent_coefficients(rng: np.random.Generator, f_hz: np.ndarray, amp: np.n
     z[:, :, 1] = np.sin(phase).T
     del phase
     coef = np.empty((n_points, n_freq), dtype=complex)
+    for pts, sl, chol in _coherence_factors(f_hz, dist, mean_speed, coherence_scale, nugget):
+        if chol.ndim == 1:  # a point alone: coherence 1 with itself (less its nugget), L = its square root
+            coef[pts[0], sl] = (z[sl, pts[0], 0] + 1j * z[sl, pts[0], 1]) * (amp[sl] * chol)
+            continue
+        lz = chol @ z[sl][:, pts]  # (f, j, 2): L applied to the cos and sin parts of z
+        coef[pts, sl] = (lz[:, :, 0] + 1j * lz[:, :, 1]).T * amp[sl]
+    return coef
+
+
+_FACTOR_CACHE: OrderedDict[bytes, list[tuple[np.ndarray, slice, np.ndarray]]] = OrderedDict()
+_FACTOR_CACHE_SIZE = 2  # factor sets kept (~14 MB each for the simulator's 65-point field)
+_FACTOR_CACHE_LOCK = threading.Lock()
+
+
+def _coherence_factors(f_hz: np.ndarray, dist: np.ndarray, mean_speed: float, coherence_scale: float,
+                       nugget: np.ndarray | None) -> list[tuple[np.ndarray, slice, np.ndarray]]:
+    """The factors of the coherence matrices of :func:`_coherent_coefficients`: ``(points, frequency slice, L)``
+    per coherent group and chunk of frequencies, ``L`` of shape ``(f, j, j)``, or ``(f,)`` (the square root of
+    one point's own coherence, 1 less its nugget). They depend on the grid, the mean wind and the frequencies,
+    not on the seed, so the last :data:`_FACTOR_CACHE_SIZE` sets are kept (read-only) for the next draws of the
+    same field -- a batch of seeds, a campaign at one wind speed; factoring them is most of a draw's cost."""
+    f_hz = np.ascontiguousarray(f_hz, dtype=float)
+    dist = np.ascontiguousarray(dist, dtype=float)
+    key = b"".join([f_hz.tobytes(), dist.tobytes(), np.array([mean_speed, coherence_scale], dtype=float).tobytes(),
+                    b"" if nugget is None else np.ascontiguousarray(nugget, dtype=float).tobytes()])
+    with _FACTOR_CACHE_LOCK:
+        hit = _FACTOR_CACHE.get(key)
+        if hit is not None:
+            _FACTOR_CACHE.move_to_end(key)
+            return hit
+    n_points = dist.shape[0]
+    out: list[tuple[np.ndarray, slice, np.ndarray]] = []
     for run, groups in _coherent_groups(dist, f_hz, mean_speed):
         for pts in groups:
-            if pts.size == 1:  # coherence 1 with itself: L = 1
-                scale = amp[run] if nugget is None else amp[run] * np.sqrt(1.0 - nugget[pts[0], run])
-                coef[pts[0], run] = (z[run, pts[0], 0] + 1j * z[run, pts[0], 1]) * scale
+            if pts.size == 1:
+                own = np.ones(run.stop - run.start) if nugget is None else np.sqrt(1.0 - nugget[pts[0], run])
+                out.append((pts, run, own))
                 continue
             d = dist[np.ix_(pts, pts)]
             chunk = max(1, _CHOLESKY_CHUNK * n_points**2 // pts.size**2)
@@ -558,10 +592,15 @@ def _coherent_coefficients(rng: np.random.Generator, f_hz: np.ndarray, amp: np.n
                 if nugget is not None:
                     diag = np.arange(pts.size)
                     coh[:, diag, diag] -= nugget[pts, sl].T
-                chol = _factor(coh)
-                lz = chol @ z[sl][:, pts]  # (f, j, 2): L applied to the cos and sin parts of z
-                coef[pts, sl] = (lz[:, :, 0] + 1j * lz[:, :, 1]).T * amp[sl]
-    return coef
+                out.append((pts, sl, _factor(coh)))
+    for pts, _, chol in out:
+        pts.setflags(write=False)
+        chol.setflags(write=False)
+    with _FACTOR_CACHE_LOCK:
+        _FACTOR_CACHE[key] = out
+        while len(_FACTOR_CACHE) > _FACTOR_CACHE_SIZE:
+            _FACTOR_CACHE.popitem(last=False)
+    return out
 
 
 def _polar_weights(radii: np.ndarray, n_azimuth: int, radius: float) -> np.ndarray:
