@@ -57,6 +57,10 @@ __all__ = [
     "DecayResult",
     "ReferenceRun",
     "ValidationReport",
+    "STEADY_SEAS_DATA",
+    "format_pooled",
+    "packaged_steady_seas_dir",
+    "pooled_over_seas",
     "azimuth_from_rotor_speed",
     "band_std",
     "damage_equivalent_load",
@@ -1107,6 +1111,18 @@ def packaged_heldout_dir() -> Path:
     return Path(str(resources.files("fowt_env") / "data" / HELDOUT_DATA))
 
 
+STEADY_SEAS_DATA = "openfast_steady_seas"
+"""Package folder of the steady 12 m/s run in five seas of one spectrum (``reference="steady-seas"``): the shared
+``d_steady12_Hs2p5_Tp10`` (wave seed 1201) and the same deck with wave seeds 1202-1205
+(``tools/openfast_steady_seed_runs.py``). Near rated the platform's slow surge is a limit cycle; how much its
+statistics move from sea to sea is what a check against the one shared sea cannot see (:func:`pooled_over_seas`)."""
+
+
+def packaged_steady_seas_dir() -> Path:
+    """Folder of the steady-wind runs in five seas shipped with fowt_env (:data:`STEADY_SEAS_DATA`)."""
+    return Path(str(resources.files("fowt_env") / "data" / STEADY_SEAS_DATA))
+
+
 def _kind(case: Mapping[str, Any]) -> str:
     return "decay" if case.get("initial") else "operating"
 
@@ -1181,7 +1197,8 @@ def load_reference(reference: str | os.PathLike[str] | None = None, runs: Sequen
     Parameters
     ----------
     reference : str or path-like, optional
-        None: the packaged compact data; ``"heldout"``: the packaged held-out runs (:data:`HELDOUT_DATA`). A
+        None: the packaged compact data; ``"heldout"``: the packaged held-out runs (:data:`HELDOUT_DATA`);
+        ``"steady-seas"``: the steady-wind run in five seas (:data:`STEADY_SEAS_DATA`). A
         folder: searched recursively for ``<run>.case.json`` sidecars, each
         beside a record ``<run>.outb`` / ``.out`` / ``.npz`` / ``.csv`` / ``.parquet``; a folder holding a
         ``summary.json`` written by ``tools/compact_openfast_reference.py`` is read like the packaged data.
@@ -1204,6 +1221,8 @@ def load_reference(reference: str | os.PathLike[str] | None = None, runs: Sequen
         root = packaged_reference_dir()
     elif str(reference) == "heldout" and not Path(reference).exists():
         root = packaged_heldout_dir()
+    elif str(reference) == "steady-seas" and not Path(reference).exists():
+        root = packaged_steady_seas_dir()
     else:
         root = Path(reference)
     if not root.is_dir():
@@ -1643,6 +1662,79 @@ def _replay_operating(run: ReferenceRun, model: Any, seeds: Sequence[int], dt: f
     for sc in replay_scores(run.record, sims[0], rotor_wind, channels=channels):
         report.replay.append({"run": run.name, **sc.to_dict()})
     return sims
+
+
+_SEA_KEYS = ("name", "wave_seed", "source", "hs", "hs_nominal")
+"""Case keys in which runs of one sea ensemble may differ (the realisation; ``hs`` is each record's realised
+height, which the surrogate follows run by run)."""
+
+
+def pooled_over_seas(report: ValidationReport) -> list[dict[str, Any]]:
+    """The graded spread statistics of runs that repeat one case in different seas (their ``case.json`` equal but
+    for the wave seed), pooled: OpenFAST's mean over the seas and its sea-to-sea scatter against the surrogate's
+    mean over the same runs (each simulated in its own sea's realised height).
+
+    One 300-600 s sea is one realisation: near rated the slow statistics of OpenFAST's own steady-wind run move by
+    12-19 % (std over five seas) from sea to sea, which a check against one sea charges to the surrogate. Pooled,
+    the ratio compares the two models' expectations. Each row carries the run-by-run tolerance of
+    :func:`spread_tolerance` applied to the pooled ratio (``passed``), informational: ``validate`` grades run by
+    run.
+
+    Returns
+    -------
+    list of dict
+        Per ensemble (at least two runs), channel and statistic: ``runs``, ``channel``, ``statistic``, ``unit``,
+        ``openfast`` (per run), ``openfast_mean``, ``openfast_cv`` (std over the runs / mean), ``surrogate_mean``,
+        ``ratio`` (``surrogate_mean / openfast_mean``), ``tolerance`` (relative) and ``passed``.
+    """
+    groups: dict[str, list[str]] = {}
+    for run in report.runs:
+        if run.get("kind") != "operating":
+            continue
+        key = json.dumps({k: v for k, v in (run.get("case") or {}).items() if k not in _SEA_KEYS}, sort_keys=True,
+                         default=str)
+        groups.setdefault(key, []).append(run["name"])
+    rows: list[dict[str, Any]] = []
+    for names in groups.values():
+        if len(names) < 2:
+            continue
+        by: dict[tuple[str, str], dict[str, Comparison]] = {}
+        for c in report.comparisons:
+            if c.run in names and c.statistic != "mean" and c.tolerance is not None:
+                by.setdefault((c.channel, c.statistic), {})[c.run] = c
+        for (channel, statistic), per_run in by.items():
+            if len(per_run) != len(names):
+                continue
+            of = np.array([per_run[n].openfast for n in names], dtype=float)
+            sur = np.array([per_run[n].surrogate for n in names], dtype=float)
+            of_mean = float(of.mean())
+            if not (np.all(np.isfinite(of)) and np.all(np.isfinite(sur)) and of_mean > 0):
+                continue
+            ratio = float(sur.mean()) / of_mean
+            tol = spread_tolerance(channel, statistic, of_mean, math.nan)
+            rel = None if tol is None else tol[0] / of_mean
+            rows.append({"runs": list(names), "channel": channel, "statistic": statistic,
+                         "unit": per_run[names[0]].unit, "openfast": [float(v) for v in of],
+                         "openfast_mean": of_mean, "openfast_cv": float(of.std(ddof=1) / of_mean),
+                         "surrogate_mean": float(sur.mean()), "ratio": ratio, "tolerance": rel,
+                         "passed": None if rel is None else bool(abs(ratio - 1.0) <= rel)})
+    return rows
+
+
+def format_pooled(rows: Sequence[Mapping[str, Any]]) -> str:
+    """:func:`pooled_over_seas` as a Markdown table (what ``fowt-env validate`` prints below its own)."""
+    if not rows:
+        return ""
+    lines = [f"Pooled over {len(rows[0]['runs'])} seas of one case ({', '.join(rows[0]['runs'])}): OpenFAST's mean "
+             "over the seas, its sea-to-sea scatter (cv), the surrogate's mean over the same runs; informational",
+             "", "| channel | statistic | OpenFAST per sea | OpenFAST mean | cv | surrogate | ratio |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        mark = "" if r["passed"] is None else (" ✓" if r["passed"] else " ✗")
+        lines.append(f"| {r['channel']} | {r['statistic']} | {' '.join(_fmt(v, 3) for v in r['openfast'])} | "
+                     f"{_fmt(r['openfast_mean'])} | {r['openfast_cv']:.2f} | {_fmt(r['surrogate_mean'])} | "
+                     f"{r['ratio']:.3g}{mark} |")
+    return "\n".join(lines) + "\n"
 
 
 def validate(
