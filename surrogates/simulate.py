@@ -1324,7 +1324,9 @@ class Simulator:
 
     def exogenous(self, u_ex: np.ndarray) -> np.ndarray:
         """Contribution of the exogenous inputs (first-order hold) to each next state, shape (n_steps, N_STATE)."""
-        return np.ascontiguousarray(u_ex[:-1] @ self.g_ex0.T + u_ex[1:] @ self.g_ex1.T)
+        exo = u_ex[:-1] @ self.g_ex0.T  # then added in place: the same sums as one expression
+        exo += u_ex[1:] @ self.g_ex1.T
+        return np.ascontiguousarray(exo)
 
     def outputs(self, x_hist: np.ndarray, u_ex_out: np.ndarray, u_hist: np.ndarray) -> np.ndarray:
         """Channel values ``C x + D u`` from stored states and inputs (n, 55), with ``PtfmRoll`` and ``PtfmYaw`` as
@@ -1533,18 +1535,23 @@ def simulate(
                 on_progress(n * sim.dt_int)
         return sim.outputs(x_hist[n_skip:], u_ex[out_steps], u_hist[n_skip:])
 
-    # FFT synthesis, the compiled stepper (nogil) and BLAS all release the GIL: a batch runs on threads
+    def run_and_noise(ch: list[np.random.SeedSequence]) -> tuple[np.ndarray, np.ndarray]:
+        truth = run_one(ch[0])
+        return truth, (sim.add_noise(truth, ch[1]) if noise else truth)
+
+    # FFT synthesis, the compiled stepper (nogil) and BLAS all release the GIL: a batch runs on threads, each seed's
+    # sensor noise drawn in its own thread from its own seed
     if len(seeds) == 1:
-        y_outs = [run_one(children[0][0])]
+        y_outs = [run_and_noise(children[0])]
     else:
         with ThreadPoolExecutor(max_workers=min(len(seeds), os.cpu_count() or 1)) as pool:
-            y_outs = list(pool.map(lambda ch: run_one(ch[0]), children))
+            y_outs = list(pool.map(run_and_noise, children))
     lc = sim.case
     t = np.arange(n_out) * sim.dt
     if replay:
         t = t + (t_start + n_skip * sim.dt)
     out: list = []
-    for s, ch, truth in zip(seeds, children, y_outs, strict=True):
+    for s, (truth, noisy) in zip(seeds, y_outs, strict=True):
         if not np.all(np.isfinite(truth)):
             raise FloatingPointError("simulation diverged (non-finite outputs); please report this case and seed")
         meta = {
@@ -1563,7 +1570,6 @@ def simulate(
         if replay:
             meta["replay"] = replay_meta(waves, wind, t_start,
                                          None if wind is None else advection_delay(sim, wind))
-        noisy = sim.add_noise(truth, ch[1]) if noise else truth
         rec = Record(t, noisy, list(ALL_CHANNELS), [UNITS[c] for c in ALL_CHANNELS], meta)
         if return_truth:
             out.append((rec, Record(t, truth, list(ALL_CHANNELS), [UNITS[c] for c in ALL_CHANNELS],
