@@ -457,6 +457,7 @@ def _loads_from_transfer_rows(rows: np.ndarray, beta: float) -> tuple[np.ndarray
     velocity[:, :, 1] = strips * sb
     return excitation, velocity
 
+
 def excitation_rao(
     f_hz: np.ndarray,
     direction_deg: float = 0.0,

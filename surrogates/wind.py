@@ -26,8 +26,6 @@ True
 
 from __future__ import annotations
 
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass, field
 from functools import lru_cache
 
@@ -554,9 +552,7 @@ def _coherent_coefficients(rng: np.random.Generator, f_hz: np.ndarray, amp: np.n
     return coef
 
 
-_FACTOR_CACHE: OrderedDict[bytes, list[tuple[np.ndarray, slice, np.ndarray]]] = OrderedDict()
 _FACTOR_CACHE_SIZE = 2  # factor sets kept (~14 MB each for the simulator's 65-point field)
-_FACTOR_CACHE_LOCK = threading.Lock()
 
 
 def _coherence_factors(f_hz: np.ndarray, dist: np.ndarray, mean_speed: float, coherence_scale: float,
@@ -568,13 +564,18 @@ def _coherence_factors(f_hz: np.ndarray, dist: np.ndarray, mean_speed: float, co
     same field -- a batch of seeds, a campaign at one wind speed; factoring them is most of a draw's cost."""
     f_hz = np.ascontiguousarray(f_hz, dtype=float)
     dist = np.ascontiguousarray(dist, dtype=float)
-    key = b"".join([f_hz.tobytes(), dist.tobytes(), np.array([mean_speed, coherence_scale], dtype=float).tobytes(),
-                    b"" if nugget is None else np.ascontiguousarray(nugget, dtype=float).tobytes()])
-    with _FACTOR_CACHE_LOCK:
-        hit = _FACTOR_CACHE.get(key)
-        if hit is not None:
-            _FACTOR_CACHE.move_to_end(key)
-            return hit
+    return _coherence_factors_of(f_hz.tobytes(), dist.tobytes(), float(mean_speed), float(coherence_scale),
+                                 None if nugget is None else np.ascontiguousarray(nugget, dtype=float).tobytes())
+
+
+@lru_cache(maxsize=_FACTOR_CACHE_SIZE)
+def _coherence_factors_of(f_key: bytes, dist_key: bytes, mean_speed: float, coherence_scale: float,
+                          nugget_key: bytes | None) -> list[tuple[np.ndarray, slice, np.ndarray]]:
+    f_hz = np.frombuffer(f_key, dtype=float)
+    dist = np.frombuffer(dist_key, dtype=float)
+    n_side = int(round(dist.size ** 0.5))
+    dist = dist.reshape(n_side, n_side)
+    nugget = None if nugget_key is None else np.frombuffer(nugget_key, dtype=float).reshape(n_side, f_hz.size)
     n_points = dist.shape[0]
     out: list[tuple[np.ndarray, slice, np.ndarray]] = []
     for run, groups in _coherent_groups(dist, f_hz, mean_speed):
@@ -596,10 +597,6 @@ def _coherence_factors(f_hz: np.ndarray, dist: np.ndarray, mean_speed: float, co
     for pts, _, chol in out:
         pts.setflags(write=False)
         chol.setflags(write=False)
-    with _FACTOR_CACHE_LOCK:
-        _FACTOR_CACHE[key] = out
-        while len(_FACTOR_CACHE) > _FACTOR_CACHE_SIZE:
-            _FACTOR_CACHE.popitem(last=False)
     return out
 
 

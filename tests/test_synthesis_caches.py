@@ -44,13 +44,15 @@ def test_kept_coherence_factors_change_nothing():
     kw = dict(n_azimuth=8, return_field=True, grid_spacing=10.0)
     first = synthesize_rotor_wind(11.0, 0.15, 120.0, 0.1, seed=5, **kw)
     again = synthesize_rotor_wind(11.0, 0.15, 120.0, 0.1, seed=5, **kw)
-    with wind._FACTOR_CACHE_LOCK:
-        wind._FACTOR_CACHE.clear()
+    wind._coherence_factors_of.cache_clear()
     fresh = synthesize_rotor_wind(11.0, 0.15, 120.0, 0.1, seed=5, **kw)
     for other in (again, fresh):
         np.testing.assert_array_equal(first.polar_u, other.polar_u)
         np.testing.assert_array_equal(first.rotor_effective, other.rotor_effective)
-    assert len(wind._FACTOR_CACHE) <= wind._FACTOR_CACHE_SIZE
-    # kept factors are read-only: a caller cannot corrupt the next draw
-    for _, _, chol in next(iter(wind._FACTOR_CACHE.values())):
-        assert not chol.flags.writeable
+    assert wind._coherence_factors_of.cache_info().currsize <= wind._FACTOR_CACHE_SIZE
+    # kept factors are read-only (a caller cannot corrupt the next draw) and come back as kept
+    f_hz, dist = np.array([0.01, 0.02, 0.05]), np.array([[0.0, 5.0], [5.0, 0.0]])
+    kept = wind._coherence_factors(f_hz, dist, 11.0, 340.2, None)
+    assert wind._coherence_factors(f_hz, dist, 11.0, 340.2, None) is kept
+    for pts, _, chol in kept:
+        assert not chol.flags.writeable and not pts.flags.writeable

@@ -76,5 +76,6 @@ def main(argv: list[str] | None = None) -> int:
                     "OC3 Hywind deck's steady-wind run and four more wave seeds)"], check=True)
     return 0
 
+
 if __name__ == "__main__":
     raise SystemExit(main())
