@@ -49,23 +49,22 @@ RUNS = {f"{SHARED_RUN}_s{seed}": dict(
 
 
 def main(argv: list[str] | None = None) -> int:
-    def case_of(name: str) -> dict:
-        seed = int(name.rsplit("_s", 1)[1])
-        return {"name": name, "wave_dir_deg": 0.0, "wind_speed": 12.0, "turbulence_intensity": 0.0,
-                "turbulence_model": "steady wind (InflowWind WindType 1), power-law shear exponent 0.2",
-                "shear_exponent": 0.2, "hs": 2.5, "tp": 10.0, "gamma": 1.0, "wave_seed": seed,
-                "transient_s": 100.0, "duration_s": 300.0,
-                "gamma_note": "SeaState WavePkShp = DEFAULT (IEC 61400-3 rule from Tp/sqrt(Hs))",
-                "source": "tools/openfast_steady_seed_runs.py: the shared d_steady12_Hs2p5_Tp10 run with "
-                          f"WaveSeed(1) = {seed} (OpenFAST v5.0.0, 2895884d)"}
-
     args, work, names = build_and_run(argv, __doc__, RUNS, DEFAULT_OUT)
+    shared_run = args.shared / "reference" / "openfast" / "runs" / SHARED_RUN
+    shared_case = json.loads((shared_run / f"{SHARED_RUN}.case.json").read_text())
+
+    def case_of(name: str) -> dict:  # the shared run's conditions, another sea
+        seed = RUNS[name]["sea"]["WaveSeed1"]
+        return {**shared_case, "name": name, "wave_seed": seed,
+                "source": f"tools/openfast_steady_seed_runs.py: the shared {SHARED_RUN} run with WaveSeed(1) = {seed} "
+                          "(OpenFAST v5.0.0, 2895884d)"}
+
     seas = work / "steady_seas"  # the four runs and the shared one, side by side for the packaging tool
     seas.mkdir(exist_ok=True)
     for name in names:
         (work / "runs" / name / f"{name}.case.json").write_text(json.dumps(case_of(name), indent=1) + "\n")
     sources = {name: work / "runs" / name for name in names}
-    sources[SHARED_RUN] = args.shared / "reference" / "openfast" / "runs" / SHARED_RUN
+    sources[SHARED_RUN] = shared_run
     for name, folder in sources.items():
         link = seas / name
         if not link.exists():
