@@ -48,6 +48,7 @@ from .validation import check_number
 __all__ = ["ROTOR_TABLES", "RotorTable", "rotor_table", "OperatingPoint", "operating_point", "RATED",
            "blade_inplane_sensitivity", "blade_inplane_gain", "inplane_ring_weights", "BladeSkewTable",
            "blade_skew_table", "skew_gains", "inclined_rotor_moment", "inclined_rotor_moment_by_pitch",
+           "inplane_wind_loads",
            "BladeDeflectionTable", "blade_deflection_table"]
 
 RATED = {
@@ -634,6 +635,68 @@ def inclined_rotor_inplane(wind_speed: float) -> tuple[float, float]:
     wind_speed = check_number("wind_speed", wind_speed, positive=True)
     v, e0, e1 = _inclined_rotor_data()
     return float(np.interp(wind_speed, v, e0)), float(np.interp(wind_speed, v, e1))
+
+
+@lru_cache(maxsize=1)
+def _inplane_wind_data() -> tuple[np.ndarray, ...]:
+    data = _inclined_rotor_json()
+    if "lateral" not in data:
+        raise RuntimeError("surrogates/data/inclined_rotor_inplane.json has no 'lateral' block: rerun "
+                           "tools/inclined_rotor_inplane_table.py")
+    lat = data["lateral"]
+    return tuple(np.asarray(x, dtype=float) for x in (
+        data["wind_speed"], lat["side_force_per_w"]["straight"], lat["side_force_per_w"]["per_m"],
+        lat["cross_moment_per_w"]["straight"], lat["cross_moment_per_w"]["per_m"]))
+
+
+def inplane_wind_loads(wind_speed: float) -> tuple[float, float, float, float]:
+    """The rotor's force along its in-plane wind and its moment across it, one blade's share per m/s (AeroDyn).
+
+    The wind's component in the rotor plane ``w`` (up the disc from the shaft's inclination, sideways from a yaw
+    misalignment, less the hub's own in-plane velocity, which is how a rolling or swaying platform meets it) pushes
+    the rotor along itself, ``F = 1.5 f w``, and turns it about the in-plane axis across itself,
+    ``M = 1.5 k e_x x w`` (``e_x`` down the shaft): a lateral ``w`` yaws the rotor, one up the disc tilts it. The
+    moment is AeroDyn's skewed wake (Pitt and Peters: more induction on the side ``w`` blows towards) and the
+    blades' cone (a blade coned downwind takes part of ``w`` as axial wind, less on the side it blows towards);
+    the force grows with the cone as well. Both are linear in the tip deflection ``d`` of the blades bent downwind:
+    ``f = f_straight + f_per_m d``, ``k = k_straight + k_per_m d``. These come beside the advancing blades' moment
+    about the axis along ``w`` (:func:`inclined_rotor_moment`) and the in-plane force across it
+    (:func:`inclined_rotor_inplane`). The simulation and the linear model apply the force in both directions and
+    the moment as a yaw moment only: the inclined rotor's tilt moment is held by the shear's calibrated tilt gain
+    (:data:`surrogates.model.ROTOR_ASYMMETRY`, which gives OpenFAST's mean tower-base moment; counted twice it
+    lowered the steady 12 m/s run's mean platform pitch by 0.026 deg, away from OpenFAST's).
+
+    Measured with OpenFAST's AeroDyn driver on the deck's rotor at the steady operating points, inclined 10 deg and
+    yawed +/-3 deg in the wind, straight and bent 5 m (``tools/inclined_rotor_inplane_table.py``, the table's
+    ``lateral`` block); linear in the wind speed between the tabulated 4-25 m/s, held outside. The moment across the
+    wind up the disc, from the same tool's inclined runs, is within 10 % of the lateral one's at 4-25 m/s (the rotor
+    is axisymmetric to that extent). At 12 m/s, one blade: 860 N and 50 kN m per m/s straight, +112 N and +24.7 kN m
+    per m of bend. A rotor translating sideways in the driver (prescribed sway at 0.034 Hz, inclined 9.8 deg,
+    1.28 deg of pitch) meets -1.4 kN and -123 kN m per m/s of its velocity straight, -2.4 kN and -323 kN m bent 5 m:
+    the bend doubles the force and nearly triples the moment. Without them the operating platform's roll was damped
+    too little and yawed too much with the roll's rate (``tests/test_roll_decay.py``): OpenFAST's rigid-bladed rotor
+    (by hand) damps the roll as the surrogate without them did.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Mean wind speed (m/s), > 0.
+
+    Returns
+    -------
+    (float, float, float, float)
+        ``f_straight`` (N per m/s), ``f_per_m`` (N per m/s per m), ``k_straight`` (N m per m/s) and ``k_per_m``
+        (N m per m/s per m).
+
+    Examples
+    --------
+    >>> f0, f1, k0, k1 = inplane_wind_loads(12.0)
+    >>> bool(f0 > 0 and f1 > 0 and k0 > 0 and k1 > 0)  # along the wind; the bent blades add to both
+    True
+    """
+    wind_speed = check_number("wind_speed", wind_speed, positive=True)
+    v, f0, f1, k0, k1 = _inplane_wind_data()
+    return tuple(float(np.interp(wind_speed, v, y)) for y in (f0, f1, k0, k1))
 
 
 @dataclass(frozen=True)

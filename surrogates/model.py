@@ -48,6 +48,7 @@ from .aero import (
     inclined_rotor_inplane,
     inclined_rotor_moment,
     inclined_rotor_moment_by_pitch,
+    inplane_wind_loads,
     operating_point,
     skew_gains,
 )
@@ -545,12 +546,18 @@ class FOWTModel:
         if linear_rotor and s_skew:
             theta0 = float(r_tt[1] @ q_static)
             inc0 = theta0 - st.data.shaft_tilt_rad
-            g_t, _, g_f = skew_gains(lc.wind_speed, inc0)
+            g_t = skew_gains(lc.wind_speed, inc0)[0]
             # the moment from AeroDyn (skewed wake, cone), at the mean flap deflection
             m0, m1 = inclined_rotor_moment(lc.wind_speed)
             g_m = m0 + eff["blade_deflection"] * m1 * float(q_static[_FLAP])
-            per_wy = j_hub.T @ np.array([0.0, -g_f, 0.0]) + r_tt.T @ np.array([0.0, g_m, 0.0])
-            per_wz = j_hub.T @ np.array([0.0, 0.0, -g_f]) + r_tt.T @ np.array([0.0, 0.0, g_m])
+            # the force along the in-plane wind and the moment across it (AeroDyn's skewed wake and the blades'
+            # cone, M = k e_x x w), at the mean flap deflection
+            f0, f1, k0, k1 = inplane_wind_loads(lc.wind_speed)
+            g_f = f0 + eff["blade_deflection"] * f1 * float(q_static[_FLAP])
+            g_c = k0 + eff["blade_deflection"] * k1 * float(q_static[_FLAP])
+            per_wy = j_hub.T @ np.array([0.0, g_f, 0.0]) + r_tt.T @ np.array([0.0, g_m, g_c])
+            per_wz = j_hub.T @ np.array([0.0, 0.0, g_f]) + r_tt.T @ np.array([0.0, 0.0, g_m])  # (no tilt: simulate)
+            # (the cross moment loads the hub only, as in the simulation)
             per_wy[_CYCLIC[0]] += flap.thrust_shape * w_t * g_t
             per_wz[_CYCLIC[1]] += flap.thrust_shape * w_y * g_t
             # the coned blades and the skewed wake meet the in-plane wind as a gradient against it: each blade's
@@ -574,6 +581,7 @@ class FOWTModel:
             f_x += np.outer(m_beta, pitch_x)
             f_u[:, ia] += m_beta
             f_x[:, _FLAP] += (gain * v0 * np.sin(inc0) * s_bend * e1 * g_ip) * (j_hub.T @ np.array([0.0, 1.0, 0.0]))
+            f_x[:, _FLAP] += (gain * v0 * np.sin(inc0) * s_bend * f1) * (j_hub.T @ np.array([0.0, 0.0, 1.0]))
             e_up = st.disc_up
             f_u[:, 0] += gain * v0 * (np.sin(inc0) - np.cos(inc0) * theta0) * per_wz
             f_u[:, iw] += gain * np.sin(inc0) * per_wz

@@ -34,6 +34,7 @@ from .aero import (
     inclined_rotor_moment,
     inclined_rotor_moment_by_pitch,
     inplane_ring_weights,
+    inplane_wind_loads,
     operating_point,
     rotor_coefficients,
     rotor_table,
@@ -160,17 +161,19 @@ def _blade_wind_columns(wind: RotorWind, wind_speed: float) -> np.ndarray:
 P_DT, P_SMOOR, P_ZF, P_SDRAG, P_ROTOR, P_V0, P_OMEGA0, P_J, P_NGEAR, P_RADIUS, P_QAREA, P_SAERO, P_TILT, \
     P_JREACT, P_GENEFF, P_SASYM, P_DTDU, P_DQDU, P_RT, P_GIP, P_RS, P_RTY, P_SKIN, P_MZG, P_RIP, P_PHIT, P_VT, P_WT, \
     P_VY, P_WY, P_FIP, P_SPINC, P_SSKEW, P_SKT, P_SKM, P_SKF, P_SBEND, P_DBEND, P_SCURV, P_INCF0, \
-    P_INCF1, P_LAGC, P_LAGS, P_SKMN, P_SKMB = range(45)
+    P_INCF1, P_LAGC, P_LAGS, P_SKMN, P_SKMB, P_SKF1, P_SKC0, P_SKC1 = range(48)
 N_SKM_NODES = 16
-P_SKM_PITCH = 45
+P_SKM_PITCH = 48
 P_SKM_K = P_SKM_PITCH + N_SKM_NODES
 N_PAR = P_SKM_K + N_SKM_NODES
 """(P_PHIT: the blade's flap mode at the thrust's centre, ``BladeFlapMode.thrust_shape``; P_VT, P_WT, P_VY, P_WY:
 :func:`surrogates.model.cyclic_flap_aero_shares`; P_FIP: the in-plane force's share of a blade's tip flap velocity,
 its gain-weighted mean of the flap shape; P_SPINC: ``c / J`` of :func:`surrogates.model.rotor_free_inertia`, how the
 rotor speed relative to the nacelle answers the nacelle's roll about the shaft; P_SSKEW: strength of
-``rotor_skew``; P_SKT, P_SKM, P_SKF: one blade's thrust, moment and in-plane force per m/s of tangential airspeed,
-:func:`surrogates.aero.skew_gains` at the equilibrium's inclination; P_SBEND, P_DBEND: strength of
+``rotor_skew``; P_SKT, P_SKM: one blade's thrust and moment per m/s of tangential airspeed,
+:func:`surrogates.aero.skew_gains` at the equilibrium's inclination; P_SKF, P_SKF1, P_SKC0, P_SKC1: one blade's force
+along the in-plane wind and moment across it per m/s of it, straight blades and per metre of tip deflection,
+:func:`surrogates.aero.inplane_wind_loads`; P_SBEND, P_DBEND: strength of
 ``blade_deflection`` and the tip deflection (m) of :func:`surrogates.aero.blade_deflection_table`'s bent blades;
 P_SCURV: strength of ``sampled_wind_curvature``; P_INCF0, P_INCF1: the in-plane force's share of the rotor's
 in-plane wind, straight blades and per metre of tip deflection, :func:`surrogates.aero.inclined_rotor_inplane`;
@@ -504,8 +507,15 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 v_up += r_pitch[4 * nd + i] * x[nd + i]
             w_z = 1.5 * s_skew * (wind * math.sin(theta - par[P_TILT]) - par[P_SAERO] * v_up)
             w_y = 1.5 * s_skew * (-wind * math.sin(yaw) - par[P_SAERO] * v_y)
-            u[hub0 + 1] += -par[P_SKF] * w_y
-            u[hub0 + 2] += -par[P_SKF] * w_z
+            # the force along the in-plane wind and the yaw moment across the lateral one (inplane_wind_loads:
+            # AeroDyn's skewed wake and the blades' cone, M = k e_x x w), growing with the blades' downwind bend;
+            # the tilt moment across the wind up the disc is held by the shear's calibrated tilt gain
+            # (ROTOR_ASYMMETRY, which gives OpenFAST's mean tower-base moment): it is left out here
+            bend = par[P_SBEND] * x[FLAP] if par[P_SBEND] > 0.0 else 0.0
+            f_w = par[P_SKF] + bend * par[P_SKF1]
+            u[hub0 + 1] += f_w * w_y
+            u[hub0 + 2] += f_w * w_z
+            u[hub0 + 5] += (par[P_SKC0] + bend * par[P_SKC1]) * w_y
             # the moment per m/s of in-plane wind follows the blade pitch along AeroDyn's operating points
             # (inclined_rotor_moment_by_pitch), relative to the equilibrium's
             k_m = par[P_SKM]
@@ -514,6 +524,9 @@ def _loads(x, ctrl, k, psi, action, u_ex, vel, blade, strip_z, drag_coef, drag_a
                 k_m += _by_pitch(par, n_sk, pitch) - par[P_SKMB]
             u[hub0 + 4] += k_m * w_y
             u[hub0 + 5] += k_m * w_z
+            # (the cross moment loads the hub only: loading the cyclic flap modes with it too, as the advancing
+            # blades' moment does, put the held platform's yaw moment per pitch rate 1.25x OpenFAST's and its slow
+            # slope on the blade pitch 0.70x; tests/test_yaw_locked.py)
             u[nl0 + _CYCLIC[0]] += par[P_PHIT] * par[P_WT] * par[P_SKT] * w_y
             u[nl0 + _CYCLIC[1]] += par[P_PHIT] * par[P_WY] * par[P_SKT] * w_z
         # rotationally sampled turbulence: each blade's wind departs from the disc mean; linear blade loads give
@@ -896,7 +909,7 @@ class Simulator:
             else:
                 pitch = None
         model._operating_states[key] = (pitch, self.x_eq.copy(), self.ctrl0[:N_CONTROLLER_STATE].copy(),
-                                        self.par[[P_SKT, P_SKF, P_SKM, P_SKMB, P_SKMN]].copy())
+                                        self.par[[P_SKT, P_SKM, P_SKMB, P_SKMN]].copy())
 
     def _build(self, warm: tuple[np.ndarray, np.ndarray] | None = None,
                state: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> None:
@@ -986,6 +999,7 @@ class Simulator:
             par[P_SSKEW] = float(eff["rotor_skew"])
             par[P_SCURV] = float(eff["sampled_wind_curvature"])
             par[P_INCF0], par[P_INCF1] = inclined_rotor_inplane(self.case.wind_speed)
+            par[P_SKF], par[P_SKF1], par[P_SKC0], par[P_SKC1] = inplane_wind_loads(self.case.wind_speed)
             par[P_LAGC], par[P_LAGS] = math.cos(DISC_RATE_LAG), math.sin(DISC_RATE_LAG)
             beta_k, k_beta = inclined_rotor_moment_by_pitch()
             n_by_pitch = beta_k.size
@@ -1007,14 +1021,14 @@ class Simulator:
         if state is not None:
             self.x_eq = np.array(state[0], dtype=float)
             self.ctrl0[:N_CONTROLLER_STATE] = state[1]
-            par[[P_SKT, P_SKF, P_SKM, P_SKMB, P_SKMN]] = state[2]
+            par[[P_SKT, P_SKM, P_SKMB, P_SKMN]] = state[2]
             return
         if warm is not None and op is not None:
             self.ctrl0[:N_CONTROLLER_STATE] = warm[1][:N_CONTROLLER_STATE]
         self.x_eq = self._equilibrium(None if warm is None else warm[0])
         if par[P_SSKEW] > 0.0:  # the skew gains at the inclination the equilibrium holds, then its share in it
             theta0 = float(st.tower_top_rotation[1] @ self.x_eq[:N_DOF])
-            par[P_SKT], _, par[P_SKF] = skew_gains(self.case.wind_speed, theta0 - d.shaft_tilt_rad)
+            par[P_SKT] = skew_gains(self.case.wind_speed, theta0 - d.shaft_tilt_rad)[0]
             # the moment from AeroDyn (skewed wake, cone), at the equilibrium's flap deflection
             m0, m1 = inclined_rotor_moment(self.case.wind_speed)
             par[P_SKM] = m0 + float(eff["blade_deflection"]) * m1 * float(self.x_eq[FLAP])

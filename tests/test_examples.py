@@ -109,12 +109,15 @@ def test_02_modes_are_the_models_and_near_the_oc3_reference(lesson):
     op, op_still = r["operating_damping_ratios"], r["operating_no_aero_damping_ratios"]
     below, below_still = r["below_rated_damping_ratios"], r["below_rated_no_aero_damping_ratios"]
     assert r["below_rated_wind_speed"] < 11.4 < surrogates.load_case(module.CASE).wind_speed  # rated: DESIGN.md
-    # the turning rotor damps fore-aft tower motion in both control regions, side-to-side hardly (the free rotor's
-    # speed answers the nacelle's roll, and its aerodynamic torque's dQ/dOmega reaches the nacelle through the
-    # generator's inertia: +14 % of the structural damping above rated)
+    # the turning rotor damps fore-aft tower motion in both control regions, side-to-side hardly: it adds less than
+    # a tenth of what it adds fore-aft (the free rotor's speed answers the nacelle's roll, its aerodynamic torque's
+    # dQ/dOmega reaching the nacelle through the generator's inertia, and the rotor's force along its lateral
+    # in-plane wind; OpenFAST's operating side-to-side tower decays: 1.06 and 1.08 % of critical at 8 and 12 m/s,
+    # tests/test_tower_side_decay.py)
     for z, z_still in ((op, op_still), (below, below_still)):
         assert z["tower_fa_1"] > 1.5 * z_still["tower_fa_1"]
-        assert z["tower_ss_1"] == pytest.approx(z_still["tower_ss_1"], rel=0.2)
+        gain_fa = z["tower_fa_1"] - z_still["tower_fa_1"]
+        assert -0.1 * gain_fa < z["tower_ss_1"] - z_still["tower_ss_1"] < 0.1 * gain_fa
     # platform pitch: damped by the rotor below rated; above rated the constant-power pitch controller takes
     # damping away (thrust falls as the platform moves upwind: Larsen & Hanson 2007, Jonkman 2008
     # NREL/CP-500-42589), and OC3's detuned controller leaves it positive

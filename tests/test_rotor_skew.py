@@ -14,9 +14,28 @@ import numpy as np
 import pytest
 
 import surrogates
-from surrogates.aero import blade_skew_table, inclined_rotor_moment, inclined_rotor_moment_by_pitch, skew_gains
+from surrogates.aero import (
+    blade_skew_table,
+    inclined_rotor_moment,
+    inclined_rotor_moment_by_pitch,
+    inplane_wind_loads,
+    skew_gains,
+)
 from surrogates.load_cases import load_case
-from surrogates.simulate import I_HUB, N_EX, P_GIP, P_INCF0, P_INCF1, P_SKF, P_SKM, P_SKT, Simulator
+from surrogates.simulate import (
+    I_HUB,
+    N_EX,
+    P_GIP,
+    P_INCF0,
+    P_INCF1,
+    P_SKC0,
+    P_SKC1,
+    P_SKF,
+    P_SKF1,
+    P_SKM,
+    P_SKT,
+    Simulator,
+)
 from surrogates.structure import N_DOF
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "reference" / "openfast" / "runs"
@@ -66,19 +85,22 @@ def test_an_inclined_rotor_carries_three_halves_of_one_blades_moment_times_the_i
     x[4] = math.radians(4.0)  # platform pitch: the top pitches with it (rigid tower)
     theta = float(st.tower_top_rotation[1] @ x[:N_DOF])
     d = _hub_loads(on, case, x, sim.ctrl0) - _hub_loads(off, case, x, sim.ctrl0)
-    g_t, g_m, g_f = sim.par[[P_SKT, P_SKM, P_SKF]]
+    g_t, g_m = sim.par[[P_SKT, P_SKM]]
     # ... the table's at the inclination of the equilibrium (found with them: a second pass moves it by ~1e-4)
     inc_eq = float(sim.x_eq[:N_DOF] @ st.tower_top_rotation[1]) - st.data.shaft_tilt_rad
-    table = skew_gains(12.0, inc_eq)
-    np.testing.assert_allclose([g_t, g_f], [table[0], table[2]], rtol=1e-3)
+    assert g_t == pytest.approx(skew_gains(12.0, inc_eq)[0], rel=1e-3)
+    # the force along the in-plane wind and the moment across it are AeroDyn's (straight, and per m of bend)
+    f0, f1, k0, k1 = sim.par[[P_SKF, P_SKF1, P_SKC0, P_SKC1]]
+    np.testing.assert_allclose([f0, f1, k0, k1], inplane_wind_loads(12.0), rtol=1e-12)
     # the moment is AeroDyn's (its skewed wake and the blades' cone) at the equilibrium's flap deflection: between
     # the driver's straight (87 kN m per m/s of in-plane wind at 12 m/s) and 5 m-bent (62) rotors
     m0, m1 = inclined_rotor_moment(12.0)
     assert g_m == pytest.approx(m0 + m1 * float(sim.x_eq[10]), rel=0.02)
     assert 60e3 < 1.5 * g_m < 88e3
     w_z = 12.0 * math.sin(theta - st.data.shaft_tilt_rad)  # the wind's component up the disc
-    assert d[5] == pytest.approx(1.5 * g_m * w_z, rel=1e-9)  # yaw moment
-    assert d[2] == pytest.approx(-1.5 * g_f * w_z, rel=1e-9)  # vertical in-plane force
+    assert d[5] == pytest.approx(1.5 * g_m * w_z, rel=1e-9)  # yaw moment (the advancing blades')
+    assert d[2] == pytest.approx(1.5 * f0 * w_z, rel=1e-9)  # vertical in-plane force, along the wind
+    # (the moment across the wind up the disc, a tilt moment, is held by the shear's calibrated tilt gain)
     assert d[4] == pytest.approx(0.0, abs=1e-6)
     # the blades' cone and the skewed wake: each blade's in-plane force sees -eps (w . e_r), three blades at
     # 120 deg sum cos^2 to 3/2: a side force 1.5 G eps w_z (blades straight here: the flap deflection is 0)
@@ -88,17 +110,25 @@ def test_an_inclined_rotor_carries_three_halves_of_one_blades_moment_times_the_i
     x[10] = 5.0
     d_bent = _hub_loads(on, case, x, sim.ctrl0) - _hub_loads(off, case, x, sim.ctrl0)
     assert d_bent[1] == pytest.approx(1.5 * g_ip * (eps0 + 5.0 * eps1) * w_z, rel=1e-9)
+    assert d_bent[2] == pytest.approx(1.5 * (f0 + 5.0 * f1) * w_z, rel=1e-9)
     x[10] = 0.0
-    # a yawed rotor: sideways in-plane wind -V sin(yaw) gives a tilt moment and a side force instead (and the
-    # cone's vertical force)
+    # a yawed rotor: sideways in-plane wind -V sin(yaw) gives a tilt moment (advancing blades), a yaw moment
+    # across it and a side force instead (and the cone's vertical force)
     x[4], x[5] = 0.0, math.radians(3.0)
     yaw = float(st.tower_top_rotation[2] @ x[:N_DOF])
     d = _hub_loads(on, case, x, sim.ctrl0) - _hub_loads(off, case, x, sim.ctrl0)
     w_y = -12.0 * math.sin(yaw)
-    assert d[4] == pytest.approx(1.5 * g_m * w_y, rel=1e-9)
     w_z = 12.0 * math.sin(-st.data.shaft_tilt_rad)  # the shaft's own tilt still inclines the rotor
-    assert d[1] == pytest.approx(-1.5 * g_f * w_y + 1.5 * g_ip * eps0 * w_z, rel=1e-9)
-    assert d[2] == pytest.approx(-1.5 * g_f * w_z - 1.5 * g_ip * eps0 * w_y, rel=1e-9)
+    assert d[4] == pytest.approx(1.5 * g_m * w_y, rel=1e-9)
+    # across the lateral wind: M = 1.5 k e_x x w
+    assert d[5] == pytest.approx(1.5 * g_m * w_z + 1.5 * k0 * w_y, rel=1e-9)
+    assert d[1] == pytest.approx(1.5 * f0 * w_y + 1.5 * g_ip * eps0 * w_z, rel=1e-9)
+    assert d[2] == pytest.approx(1.5 * f0 * w_z - 1.5 * g_ip * eps0 * w_y, rel=1e-9)
+    # bent 5 m downwind the force and the moment grow by 5 f1 and 5 k1
+    x[10] = 5.0
+    d_bent = _hub_loads(on, case, x, sim.ctrl0) - _hub_loads(off, case, x, sim.ctrl0)
+    assert d_bent[5] == pytest.approx(1.5 * g_m * w_z + 1.5 * (k0 + 5.0 * k1) * w_y, rel=1e-9)
+    assert d_bent[1] == pytest.approx(1.5 * (f0 + 5.0 * f1) * w_y + 1.5 * g_ip * (eps0 + 5.0 * eps1) * w_z, rel=1e-9)
 
 
 def test_the_inclined_rotors_moment_follows_the_blade_pitch_from_the_equilibriums():

@@ -230,11 +230,12 @@ def _is_numbers(tokens: list[str]) -> bool:
 
 
 def driver_text(ad_file: str, geo: dict, env: dict, tilt_deg: float, cases: list[tuple]) -> str:
-    """AeroDyn driver input: basic HAWT with the deck's geometry, combined cases (V, PLExp, rpm, pitch, dt, tmax)."""
+    """AeroDyn driver input: basic HAWT with the deck's geometry, combined cases (V, PLExp, rpm, pitch, dt, tmax) or
+    (V, PLExp, rpm, pitch, dt, tmax, yaw): the nacelle yawed ``yaw`` deg (about the vertical) in the wind."""
     tilt = math.radians(tilt_deg)  # upwind end of the shaft up (OpenFAST's ShftTilt = -tilt_deg)
     hub_ht = geo["TowerHt"] + geo["Twr2Shft"] - geo["OverHang"] * math.sin(tilt)  # tower top stays at TowerHt
-    rows = "\n".join(f"{v:.6f}  {pl:.4f}  {rpm:.6f}  {p:.4f}  0.0  {dt:.6g}  {tm:.6f}  0  0  0"
-                     for v, pl, rpm, p, dt, tm in cases)
+    rows = "\n".join(f"{v:.6f}  {pl:.4f}  {rpm:.6f}  {p:.4f}  {(yaw[0] if yaw else 0.0):.4f}  {dt:.6g}  {tm:.6f}"
+                      "  0  0  0" for v, pl, rpm, p, dt, tm, *yaw in cases)
     return f"""----- AeroDyn Driver Input File ---------------------------------------------------------
 tools/aerodyn_rotor_table.py: steady rotor coefficients of the OC3 reference deck
 ----- Input Configuration ---------------------------------------------------------------

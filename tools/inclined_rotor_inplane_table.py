@@ -73,18 +73,19 @@ import aerodyn_rotor_table as art  # noqa: E402
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 DEFAULT_OUT = REPO / "surrogates" / "data" / "inclined_rotor_inplane.json"
-OUTPUTS = ("RtAeroFxh", "RtAeroMxh", "RtAeroFyi", "RtAeroFzi", "RtAeroMxi", "RtAeroMyi", "RtAeroMzi")
+OUTPUTS = ("RtAeroFxh", "RtAeroMxh", "RtAeroFxi", "RtAeroFyi", "RtAeroFzi", "RtAeroMxi", "RtAeroMyi", "RtAeroMzi")
 RPM = 12.0
 
 
-def driver_run(driver: Path, work: Path, ad_text: str, inp: dict, tilt: float, cases: list[tuple[float, float]],
+def driver_run(driver: Path, work: Path, ad_text: str, inp: dict, tilt: float, cases: list[tuple[float, ...]],
                revs: int) -> list[dict[str, float]]:
-    """Mean rotor loads (last revolution) of combined cases ``(wind m/s, pitch deg)`` at inclination ``tilt``."""
+    """Mean rotor loads (last revolution) of combined cases ``(wind m/s, pitch deg)`` or ``(wind m/s, pitch deg, yaw
+    deg)`` at inclination ``tilt``."""
     work.mkdir(parents=True, exist_ok=True)
     geo, env = inp["geo"], inp["env"]
     dt = env["DT"]
     n_rev = int(round(60.0 / RPM / dt))
-    rows = [(v, 0.0, RPM, p, dt, revs * 60.0 / RPM) for v, p in cases]
+    rows = [(c[0], 0.0, RPM, c[1], dt, revs * 60.0 / RPM, *c[2:]) for c in cases]
     (work / "AeroDyn.dat").write_text(ad_text)
     (work / "incl.dvr").write_text(art.driver_text("AeroDyn.dat", geo, env, tilt, rows))
     proc = subprocess.run([str(driver), "incl.dvr"], cwd=work, capture_output=True, text=True, errors="replace")
@@ -116,6 +117,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--wind", type=float, nargs="+", default=list(np.arange(4.0, 25.01, 1.0)),
                     help="wind speeds of the operating points, m/s (default 4..25)")
     ap.add_argument("--revs", type=int, default=4, help="revolutions per case (default 4)")
+    ap.add_argument("--yaw", type=float, default=3.0,
+                    help="the nacelle's yaw (+/-, deg) of the lateral runs, at the second inclination (default 3)")
     ap.add_argument("--workdir", default="/tmp/inclined_rotor_inplane", help="driver runs")
     ap.add_argument("--out", default=str(DEFAULT_OUT))
     args = ap.parse_args(argv)
@@ -165,6 +168,38 @@ def main(argv: list[str] | None = None) -> int:
     check.update(wind_speed=round(v_chk, 4), side_force_N=side)
     print("check:", check)
 
+    # the lateral in-plane wind: the rotor inclined by the second inclination and yawed +/- args.yaw in the wind,
+    # loads in hub axes (x down the shaft, y to the side, z up the disc); w_y = -V sin(yaw)
+    lateral: dict[float, list[dict[str, float]]] = {}
+    for tip in (0.0, args.tip):
+        ad_text, _ = aerodyn_text(tip)
+        cases = [(v, p, sgn * args.yaw) for v, p in zip(v_drv, pitch, strict=True) for sgn in (1.0, -1.0)]
+        lateral[tip] = driver_run(Path(args.driver), work / f"tip{tip:g}_yaw{args.yaw:g}", ad_text, inp,
+                                  args.tilts[1], cases, args.revs)
+        print(f"tip {tip:g} m, yawed +/-{args.yaw:g} deg: done", flush=True)
+
+    def hub_axes(row: dict[str, float], yaw_deg: float, tilt_deg: float) -> dict[str, float]:
+        g, t = math.radians(yaw_deg), math.radians(tilt_deg)
+        y_s = np.array([-math.sin(g), math.cos(g), 0.0])
+        z_s = np.array([math.cos(g) * math.sin(t), math.sin(g) * math.sin(t), math.cos(t)])
+        f = np.array([row["RtAeroFxi"], row["RtAeroFyi"], row["RtAeroFzi"]])
+        m = np.array([row["RtAeroMxi"], row["RtAeroMyi"], row["RtAeroMzi"]])
+        return {"side": float(f @ y_s), "yaw": float(m @ z_s), "tilt": float(m @ y_s)}
+
+    def per_lateral_wind(tip: float, name: str) -> np.ndarray:
+        """One blade's share (1/1.5 of the rotor's) of the load per m/s of lateral wind, at the operating point's
+        own wind (the driver's slope times V / V')."""
+        out = []
+        for k, vd in enumerate(v_drv):
+            plus = hub_axes(lateral[tip][2 * k], args.yaw, args.tilts[1])[name]
+            minus = hub_axes(lateral[tip][2 * k + 1], -args.yaw, args.tilts[1])[name]
+            dw = -2.0 * vd * math.sin(math.radians(args.yaw))
+            out.append((plus - minus) / dw / 1.5 * winds[k] / vd)
+        return np.array(out)
+
+    lat = {name: (per_lateral_wind(0.0, name), (per_lateral_wind(args.tip, name) - per_lateral_wind(0.0, name))
+                  / args.tip) for name in ("side", "yaw", "tilt")}
+
     t0, t1 = args.tilts
     d_w = v_drv * (math.sin(math.radians(t1)) - math.sin(math.radians(t0)))
 
@@ -182,6 +217,15 @@ def main(argv: list[str] | None = None) -> int:
 
     for v, e0, e1 in zip(winds, eps0, eps1, strict=True):
         print(f"V {v:5.1f} m/s: eps straight {e0:+.4f}, per m of tip deflection {e1:+.5f}")
+    # the cross moment of the in-plane wind up the disc (the inclination's tilt moment), one blade's, per m/s:
+    # the same physics as the lateral wind's yaw moment, turned a quarter turn (M = k e_x x W: tilt = -k W_z)
+    cross_up = [-(b["RtAeroMyi"] - a["RtAeroMyi"]) / (1.5 * dw) * v / vd for a, b, dw, v, vd in
+                zip(loads[(0.0, t0)], loads[(0.0, t1)], d_w, winds, v_drv, strict=True)]
+    for k, v in enumerate(winds):
+        print(f"V {v:5.1f} m/s, one blade per m/s of lateral wind: side force {lat['side'][0][k]:+8.1f} N "
+              f"({lat['side'][1][k]:+7.1f}/m), yaw moment {lat['yaw'][0][k] / 1e3:+7.1f} kN m "
+              f"({lat['yaw'][1][k] / 1e3:+6.2f}/m; up the disc, straight: {cross_up[k] / 1e3:+7.1f}), tilt moment "
+              f"{lat['tilt'][0][k] / 1e3:+7.1f} kN m ({lat['tilt'][1][k] / 1e3:+6.2f}/m)")
     out = {
         "description": (
             "The inclined OC3 rotor's in-plane (side) force against the wind's component up the rotor plane, from "
@@ -209,6 +253,23 @@ def main(argv: list[str] | None = None) -> int:
                         "axis, RtAeroMzi cos(t) + RtAeroMxi sin(t) -- the inertial RtAeroMzi of the tilted shaft also "
                         "carries the aerodynamic torque's projection Q sin(t)"),
         "check_steady_run_conditions": check,
+        "lateral": {
+            "description": (
+                "The rotor inclined by the second inclination and yawed +/- yaw_deg in the wind: one blade's share "
+                "(the rotor's load / 1.5) per m/s of the lateral in-plane wind w_y = -V sin(yaw), in hub axes, at "
+                "the operating point's own wind: the side force along w_y, the yaw moment about the disc's "
+                "vertical (the cross moment M = k e_x x w of AeroDyn's skewed wake and the blades' cone) and the "
+                "tilt moment (the advancing blades'); straight blades and the growth per m of tip deflection."),
+            "yaw_deg": args.yaw,
+            "inclination_deg": t1,
+            "side_force_per_w": {"straight": [round(float(x), 3) for x in lat["side"][0]],
+                                 "per_m": [round(float(x), 4) for x in lat["side"][1]]},
+            "cross_moment_per_w": {"straight": [round(float(x), 2) for x in lat["yaw"][0]],
+                                   "per_m": [round(float(x), 3) for x in lat["yaw"][1]]},
+            "tilt_moment_per_w": {"straight": [round(float(x), 2) for x in lat["tilt"][0]],
+                                  "per_m": [round(float(x), 3) for x in lat["tilt"][1]]},
+            "cross_moment_up_the_disc_straight": [round(float(x), 2) for x in cross_up],
+        },
     }
     Path(args.out).write_text(json.dumps(out, indent=1) + "\n")
     print(f"wrote {args.out}")
