@@ -20,6 +20,13 @@ What
     outside the table's conditions: straight and bent (5.26 m) blades at the shared steady-wind run's tip-speed
     ratio (6.65), pitch (1 and 2 deg) and inclination (10.2 deg).
 
+    It also yaws the rotor (inclined by the second inclination) +/- ``--yaw`` deg in the wind, straight and bent,
+    and writes the ``lateral`` block: one blade's share of the side force along the lateral in-plane wind
+    ``w_y = -V sin(yaw)``, of the yaw moment across it (AeroDyn's skewed wake and the blades' cone) and of the tilt
+    moment (the advancing blades', a check on ``yaw_moment_change_Nm``'s moment), each straight and per metre of
+    bend, which :func:`surrogates.aero.inplane_wind_loads` reads; and, as a check of the rotor's symmetry, the
+    moment across the wind up the disc from the inclined runs' tilt moment.
+
 Why
     OpenFAST's rotor in its steady 12 m/s sheared wind, platform held at the steady run's mean position
     (``tools/openfast_blade_flex_runs.py``), puts a side force of -10.1 kN on the yaw bearing (``YawBrFyp``) with
@@ -47,7 +54,7 @@ How
     and pitch). Inclinations 5 and 10 deg rather than 0 and 10: blades bent 5 m downwind would meet AeroDyn's tower
     potential flow in an untilted rotor (a "tower strike" stops the driver).
 
-Usage (maintainer tool, not run by the tests; about 2 minutes on one core)::
+Usage (maintainer tool, not run by the tests; about 4 minutes on one core)::
 
     python tools/inclined_rotor_inplane_table.py --driver /tmp/of/build/modules/aerodyn/aerodyn_driver \\
         [--shared ../shared] [--tip 5] [--workdir DIR]
