@@ -140,8 +140,9 @@ def test_the_gyroscopic_yaw_moment_is_openfasts():
 def test_the_operating_yaw_moment_per_pitch_rate_is_openfasts():
     """Operating in steady 12 m/s wind: the held platform's yaw moment per unit pitch rate over 0.08-0.14 Hz, in
     phase within 25 % of OpenFAST's (what the aerodynamic moment leaves of the gyroscopic one, 0.27 of it in this
-    band) and in quadrature within 35 % (measured +2 % and -1 %). Without :data:`surrogates.model.DISC_RATE_LAG_DEG`
-    the in-phase part is 1.63x OpenFAST's, the quadrature 1.33x."""
+    band) and in quadrature within 35 % (measured -12 % and +30 %: 17.2 / -17.8 against 19.6 / -13.7 MN m s; +2 %
+    and -1 % when :data:`surrogates.model.DISC_RATE_LAG_DEG` was fitted, -13 % and +32 % on the checkout before the
+    rotor's in-plane wind loads). Without the lag the in-phase part was 1.63x OpenFAST's, the quadrature 1.33x."""
     _, h_of = _openfast("yl_steady12_Hs2p5_Tp10")
     assert 15e6 < h_of.real < 25e6 and -20e6 < h_of.imag < -10e6  # the record's own figures, a guard
     _, h = _surrogate(("yaw",))
