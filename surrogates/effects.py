@@ -63,11 +63,13 @@ EFFECTS: dict[str, Effect] = {
                "inclination under the wind, a yaw misalignment, the hub's own in-plane motion) changes each blade's "
                "airspeed once per revolution, hence its thrust and in-plane force: the inclined rotor's yaw moment "
                "and the yawed rotor's tilt moment (AeroDyn's driver on the deck's rotor, with its skewed wake, at the "
-               "blades' mean deflection, following the blade pitch along the regulated operating points) and an "
-               "in-plane aerodynamic force (blade-element sensitivities of the "
-               "deck's blade at the step's tip-speed ratio and pitch); and the coned blades and AeroDyn's skewed "
-               "wake meet that in-plane wind as a gradient against it, which takes back part of the shear's side "
-               "force (AeroDyn's driver on the deck's rotor, inclined 5 and 10 deg).", linear=True),
+               "blades' mean deflection, following the blade pitch along the regulated operating points); a force "
+               "along the in-plane wind and a yaw moment across the lateral one (AeroDyn's skewed wake and the "
+               "blades' cone, growing with their downwind bend; AeroDyn's driver on the deck's rotor yawed +/-3 deg, "
+               "straight and bent: what damps the operating platform's roll as OpenFAST's flexible rotor does); and "
+               "the coned blades and AeroDyn's skewed wake meet that in-plane wind as a gradient against it, which "
+               "takes back part of the shear's side force (AeroDyn's driver on the deck's rotor, inclined 5 and "
+               "10 deg).", linear=True),
         Effect("blade_deflection", "The blades' collective flap deflection bends them downwind at constant length "
                "(coned, turned by their slope, shorter in radius): the rotor's thrust and torque coefficients fall "
                "with the square of the tip deflection, by ~2 % and ~3 % at rated's 5 m (AeroDyn on the deck's bent "
