@@ -766,60 +766,16 @@ def _interp_columns(t, delay, t_field, values, out):
 
 
 @numba.njit(cache=True, nogil=True)
-def _sensor_noise(y, eta, white, coloured, sigma, theta, a, out):
-    """``out = y + s``: per channel with coloured noise the ARMA(1,1) ``s[t] = a s[t-1] + sigma (eta[t] + theta
-    eta[t-1])`` (``s[-1] = eta[-1] = 0``), the sum of the white and the AR(1) coloured noise as one process
-    (:func:`arma_sensor_noise`); per channel without, ``s = white eta``."""
+def _sensor_noise(y, e_white, white, e_col, col, gain, a, out):
+    """``out = y + e_white white + c``, with ``c`` the AR(1) coloured noise ``c[t] = e_col[t] col gain + a c[t-1]``
+    (``c[-1] = 0``) of every channel: the arithmetic of ``lfilter([1], [1, -a], e_col * col * gain, axis=0)``, in
+    one pass without temporaries."""
     n, m = y.shape
     state = np.zeros(m)
-    prev = np.zeros(m)
     for t in range(n):
         for c in range(m):
-            if coloured[c]:
-                state[c] = a * state[c] + sigma[c] * (eta[t, c] + theta[c] * prev[c])
-                prev[c] = eta[t, c]
-                out[t, c] = y[t, c] + state[c]
-            else:
-                out[t, c] = y[t, c] + eta[t, c] * white[c]
-
-
-def arma_sensor_noise(white: np.ndarray, coloured: np.ndarray, a: float) -> tuple[np.ndarray, np.ndarray]:
-    """White plus AR(1) coloured noise as one ARMA(1,1) process: its innovation scale and MA coefficient.
-
-    The sum ``s = w e + c`` of white noise (std ``w``) and the AR(1) noise ``c[t] = a c[t-1] + col sqrt(1 - a^2)
-    e'[t]`` (std ``col``), ``e`` and ``e'`` independent standard normals, satisfies ``(1 - a L) s = w (1 - a L) e +
-    col sqrt(1 - a^2) e'``, whose right side is a moving average of order one with autocovariances
-    ``g0 = w^2 (1 + a^2) + col^2 (1 - a^2)`` and ``g1 = -a w^2``; written ``sigma (eta[t] + theta eta[t-1])`` with one
-    standard normal sequence ``eta`` (``sigma^2 (1 + theta^2) = g0``, ``sigma^2 theta = g1``, ``|theta| < 1``), the
-    process has the same autocovariance, ``w^2 + col^2`` at lag 0 and ``col^2 a^k`` at lag ``k``, from half the
-    normal draws.
-
-    Parameters
-    ----------
-    white, coloured : ndarray (m,)
-        Standard deviations of the white and the coloured noise per channel (channel units), >= 0.
-    a : float
-        The AR(1) coefficient ``exp(-dt / correlation_time)``, in [0, 1).
-
-    Returns
-    -------
-    (ndarray, ndarray)
-        ``sigma`` (channel units) and ``theta`` (-) per channel.
-
-    Examples
-    --------
-    >>> sigma, theta = arma_sensor_noise(np.array([1.0]), np.array([0.0]), 0.5)  # white only: s = eta
-    >>> float(sigma[0]), float(theta[0])
-    (1.0, -0.5)
-    """
-    w2 = np.asarray(white, dtype=float) ** 2
-    g0 = w2 * (1.0 + a * a) + np.asarray(coloured, dtype=float) ** 2 * (1.0 - a * a)
-    g1 = -a * w2
-    rho = np.divide(g1, g0, out=np.zeros_like(g0), where=g0 > 0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        theta = np.where(rho != 0.0, (1.0 - np.sqrt(np.maximum(1.0 - 4.0 * rho * rho, 0.0))) / (2.0 * rho), 0.0)
-    sigma = np.sqrt(g0 / (1.0 + theta * theta))
-    return sigma, theta
+            state[c] = e_col[t, c] * col[c] * gain + a * state[c]
+            out[t, c] = (y[t, c] + e_white[t, c] * white[c]) + state[c]
 
 
 # -------------------------------------------------------------------------------------------- discretised
@@ -1396,22 +1352,19 @@ class Simulator:
         return y
 
     def add_noise(self, y: np.ndarray, seed_sequence: np.random.SeedSequence) -> np.ndarray:
-        """Add white + AR(1) coloured sensor noise (model.noise) to outputs ``y`` (n, 55): per channel one
-        standard normal sequence, as the ARMA(1,1) process the sum is (:func:`arma_sensor_noise`), from zero state
-        (the coloured part rises to its level over the correlation time)."""
+        """Add white + AR(1) coloured sensor noise (model.noise) to outputs ``y`` (n, 55)."""
         white, col = self.model.noise.std(list(ALL_CHANNELS))
         if not np.any(white) and not np.any(col):
             return y
         rng = np.random.default_rng(seed_sequence)
-        eta = rng.standard_normal(y.shape)
+        e_white = rng.standard_normal(y.shape)
         if not np.any(col):
-            return y + eta * white
-        # the white and the coloured noise drawn as one ARMA(1,1) sequence: the same process, half the draws
+            return y + e_white * white
         a = math.exp(-self.dt / max(self.model.noise.correlation_time, 1e-9))
-        white = np.asarray(white, dtype=float)
-        sigma, theta = arma_sensor_noise(white, col, a)
+        e_col = rng.standard_normal(y.shape)
         out = np.empty(y.shape)
-        _sensor_noise(np.ascontiguousarray(y, dtype=float), eta, white, np.asarray(col) > 0, sigma, theta, a, out)
+        _sensor_noise(np.ascontiguousarray(y, dtype=float), e_white, np.asarray(white, dtype=float), e_col,
+                      np.asarray(col, dtype=float), math.sqrt(1.0 - a * a), a, out)
         return out
 
 
