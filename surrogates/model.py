@@ -556,8 +556,9 @@ class FOWTModel:
             g_f = f0 + eff["blade_deflection"] * f1 * float(q_static[_FLAP])
             g_c = k0 + eff["blade_deflection"] * k1 * float(q_static[_FLAP])
             per_wy = j_hub.T @ np.array([0.0, g_f, 0.0]) + r_tt.T @ np.array([0.0, g_m, g_c])
-            per_wz = j_hub.T @ np.array([0.0, 0.0, g_f]) + r_tt.T @ np.array([0.0, 0.0, g_m])  # (no tilt: simulate)
-            # (the cross moment loads the hub only, as in the simulation)
+            # (the moment across the wind up the disc, a tilt moment, is left out and the cross moment loads the
+            # hub only, not the cyclic flap modes: as in the simulation, whose kernel says why)
+            per_wz = j_hub.T @ np.array([0.0, 0.0, g_f]) + r_tt.T @ np.array([0.0, 0.0, g_m])
             per_wy[_CYCLIC[0]] += flap.thrust_shape * w_t * g_t
             per_wz[_CYCLIC[1]] += flap.thrust_shape * w_y * g_t
             # the coned blades and the skewed wake meet the in-plane wind as a gradient against it: each blade's

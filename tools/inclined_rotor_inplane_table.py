@@ -204,8 +204,10 @@ def main(argv: list[str] | None = None) -> int:
             out.append((plus - minus) / dw / 1.5 * winds[k] / vd)
         return np.array(out)
 
-    lat = {name: (per_lateral_wind(0.0, name), (per_lateral_wind(args.tip, name) - per_lateral_wind(0.0, name))
-                  / args.tip) for name in ("side", "yaw", "tilt")}
+    lat = {}
+    for name in ("side", "yaw", "tilt"):
+        straight = per_lateral_wind(0.0, name)
+        lat[name] = (straight, (per_lateral_wind(args.tip, name) - straight) / args.tip)
 
     t0, t1 = args.tilts
     d_w = v_drv * (math.sin(math.radians(t1)) - math.sin(math.radians(t0)))
